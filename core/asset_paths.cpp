@@ -1,0 +1,66 @@
+#include "core/asset_paths.hpp"
+
+#include <cstdlib>
+#include "core/error.hpp"
+
+namespace gilab {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+void append_colon_separated(const std::string& list, std::vector<fs::path>& out) {
+    size_t start = 0;
+    while (start <= list.size()) {
+        size_t end = list.find(':', start);
+        if (end == std::string::npos) end = list.size();
+        if (end > start) out.emplace_back(list.substr(start, end - start));
+        start = end + 1;
+    }
+}
+
+bool is_file(const fs::path& p) {
+    std::error_code ec;
+    return fs::is_regular_file(p, ec);
+}
+
+}  // namespace
+
+AssetPaths AssetPaths::from_environment(const std::optional<std::string>& flag_value) {
+    std::vector<fs::path> dirs;
+    if (flag_value) append_colon_separated(*flag_value, dirs);
+    if (const char* env = std::getenv("GILAB_ASSETS")) append_colon_separated(env, dirs);
+    dirs.push_back(fs::path(GILAB_SOURCE_DIR "/../shared/scenes").lexically_normal());
+    return AssetPaths(std::move(dirs));
+}
+
+std::optional<fs::path> AssetPaths::find(const std::string& relative) const {
+    if (relative.empty()) return std::nullopt;
+    const fs::path p(relative);
+    if (is_file(p)) return p;
+    if (p.is_absolute()) return std::nullopt;
+    for (const fs::path& dir : dirs_) {
+        fs::path candidate = dir / p;
+        if (is_file(candidate)) return candidate;
+    }
+    return std::nullopt;
+}
+
+fs::path AssetPaths::resolve(const std::string& relative) const {
+    if (auto found = find(relative)) return *found;
+    std::string searched = "the working directory";
+    if (!fs::path(relative).is_absolute() && !dirs_.empty()) searched += ", " + describe();
+    throw Error("asset '" + relative + "' not found (searched " + searched +
+                "; add a directory with --assets or GILAB_ASSETS)");
+}
+
+std::string AssetPaths::describe() const {
+    std::string s;
+    for (const fs::path& dir : dirs_) {
+        if (!s.empty()) s += ":";
+        s += dir.string();
+    }
+    return s;
+}
+
+}  // namespace gilab

@@ -1,0 +1,30 @@
+#pragma once
+// Where scene assets are looked up: --assets flag, then $GILAB_ASSETS (colon-separated),
+// then ../shared/scenes next to the source tree.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace gilab {
+
+class AssetPaths {
+public:
+    AssetPaths() = default;
+    explicit AssetPaths(std::vector<std::filesystem::path> dirs) : dirs_(std::move(dirs)) {}
+    // flag_value: the --assets option if given (may itself be colon-separated).
+    static AssetPaths from_environment(const std::optional<std::string>& flag_value = {});
+
+    // An absolute path or one relative to the working directory is used if it exists;
+    // otherwise each search directory is tried in order. Throws Error listing the
+    // directories searched when nothing is found.
+    std::filesystem::path resolve(const std::string& relative) const;
+    std::optional<std::filesystem::path> find(const std::string& relative) const;
+    const std::vector<std::filesystem::path>& dirs() const { return dirs_; }
+    std::string describe() const;  // "dir1:dir2"
+
+private:
+    std::vector<std::filesystem::path> dirs_;
+};
+
+}  // namespace gilab

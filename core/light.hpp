@@ -1,0 +1,26 @@
+#pragma once
+// Punctual lights (point, spot, directional). Area lights are emissive triangles: any
+// triangle whose material has emission is a light (see LightSampler).
+#include <string>
+#include "core/math.hpp"
+
+namespace gilab {
+
+enum class LightType { Point, Spot, Directional };
+
+struct PunctualLight {
+    std::string name;
+    LightType type = LightType::Point;
+    Vec3 position{0};            // point, spot (world space after evaluation)
+    Vec3 direction{0, -1, 0};    // spot and directional: direction the light travels
+    // Point/spot: radiant intensity, W/sr per channel. Directional: irradiance on a
+    // surface facing the light, W/m² per channel.
+    Vec3 intensity{1};
+    float cos_inner = 1.0f;      // spot: full intensity inside this cone
+    float cos_outer = 0.0f;      // spot: zero outside this cone
+    int node = -1;               // scene node the light is attached to, -1 = world
+};
+
+const char* to_string(LightType type);
+
+}  // namespace gilab

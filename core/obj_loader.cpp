@@ -1,0 +1,275 @@
+// Wavefront OBJ + MTL through tinyobjloader. tinyobjloader reads unparsable numbers as
+// 0 and skips faces with bad indices with only a warning, so a quick pre-scan of the
+// file checks vertex and face lines first and reports problems with their line number.
+#include <tiny_obj_loader.h>
+
+#include <charconv>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <unordered_map>
+#include "core/error.hpp"
+#include "core/mesh_loaders.hpp"
+
+namespace gilab {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct PreScan {
+    std::vector<uint32_t> face_lines;  // line number of every face, in file order
+};
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r'; }
+
+std::string_view next_token(std::string_view& rest) {
+    size_t b = 0;
+    while (b < rest.size() && is_space(rest[b])) ++b;
+    size_t e = b;
+    while (e < rest.size() && !is_space(rest[e]) && rest[e] != '#') ++e;
+    std::string_view tok = rest.substr(b, e - b);
+    rest = (e < rest.size() && rest[e] == '#') ? std::string_view{} : rest.substr(e);
+    return tok;
+}
+
+bool parse_float(std::string_view tok, float& out) {
+    if (!tok.empty() && tok.front() == '+') tok.remove_prefix(1);
+    auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), out);
+    return ec == std::errc() && ptr == tok.data() + tok.size();
+}
+
+PreScan prescan(const fs::path& path, const std::string& text) {
+    PreScan scan;
+    const std::string file = path.string();
+    uint32_t line_no = 0;
+    size_t pos = 0;
+    while (pos < text.size()) {
+        size_t end = text.find('\n', pos);
+        if (end == std::string::npos) end = text.size();
+        std::string_view line(text.data() + pos, end - pos);
+        pos = end + 1;
+        ++line_no;
+        size_t b = 0;
+        while (b < line.size() && is_space(line[b])) ++b;
+        line.remove_prefix(b);
+        if (line.size() < 2 || !is_space(line[1])) continue;
+        const std::string where = file + ":" + std::to_string(line_no);
+        if (line[0] == 'v') {
+            std::string_view rest = line.substr(2);
+            for (int k = 0; k < 3; ++k) {
+                std::string_view tok = next_token(rest);
+                float value = 0;
+                if (tok.empty())
+                    throw Error(where, "vertex has " + std::to_string(k) +
+                                           " coordinates, expected 3 (malformed or truncated file)");
+                if (!parse_float(tok, value))
+                    throw Error(where, "vertex coordinate '" + std::string(tok) + "' is not a number");
+                if (!std::isfinite(value))
+                    throw Error(where, "vertex coordinate '" + std::string(tok) + "' is not finite (NaN/Inf vertex)");
+            }
+        } else if (line[0] == 'f') {
+            std::string_view rest = line.substr(2);
+            int corners = 0;
+            while (!next_token(rest).empty()) ++corners;
+            if (corners < 3)
+                throw Error(where, "face has " + std::to_string(corners) +
+                                       " vertices, expected at least 3 (malformed or truncated file)");
+            if (corners > 255) throw Error(where, "face has more than 255 vertices (unsupported)");
+            scan.face_lines.push_back(line_no);
+        }
+    }
+    return scan;
+}
+
+std::string read_text(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(path.string(), "cannot open file");
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+// tinyobjloader's messages end in "(line N.)"; move the line number to the front.
+std::string locate_message(const std::string& file, const std::string& message) {
+    static const std::regex line_re(R"(line:? (\d+))");
+    std::smatch m;
+    std::string msg = message;
+    while (!msg.empty() && (msg.back() == '\n' || msg.back() == ' ')) msg.pop_back();
+    if (std::regex_search(msg, m, line_re)) return file + ":" + m[1].str() + ": " + msg;
+    return file + ": " + msg;
+}
+
+Vec3 to_vec3(const tinyobj::real_t v[3]) { return Vec3(float(v[0]), float(v[1]), float(v[2])); }
+
+Material convert_material(const tinyobj::material_t& m, bool& rescaled) {
+    Material out;
+    out.name = m.name;
+    out.albedo = glm::clamp(to_vec3(m.diffuse), Vec3(0.0f), Vec3(1.0f));
+    out.specular = glm::max(to_vec3(m.specular), Vec3(0.0f));
+    out.phong_exponent = std::max(float(m.shininess), 0.0f);
+    out.emission = glm::max(to_vec3(m.emission), Vec3(0.0f));
+    // Kd + Ks > 1 would reflect more than arrives; keep the diffuse colour and scale
+    // the glossy lobe down uniformly.
+    float scale = 1.0f;
+    for (int c = 0; c < 3; ++c)
+        if (out.albedo[c] + out.specular[c] > 1.0f && out.specular[c] > 0.0f)
+            scale = std::min(scale, (1.0f - out.albedo[c]) / out.specular[c]);
+    if (scale < 1.0f) {
+        out.specular *= scale;
+        rescaled = true;
+    }
+    return out;
+}
+
+struct CornerKey {
+    int v, n, t;
+    bool operator==(const CornerKey& o) const { return v == o.v && n == o.n && t == o.t; }
+};
+struct CornerHash {
+    size_t operator()(const CornerKey& k) const {
+        return (size_t(uint32_t(k.v)) * 0x9E3779B97F4A7C15ull) ^ (size_t(uint32_t(k.n)) * 0xC2B2AE3D27D4EB4Full) ^
+               size_t(uint32_t(k.t));
+    }
+};
+
+}  // namespace
+
+Scene load_obj(const fs::path& path) {
+    const std::string file = path.string();
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) throw Error(file, "file not found");
+
+    const PreScan scan = prescan(path, read_text(path));
+
+    tinyobj::ObjReaderConfig config;
+    config.triangulate = false;  // fan-triangulated below, after the indices are checked
+    config.vertex_color = false;
+    tinyobj::ObjReader reader;
+    if (!reader.ParseFromFile(file, config))
+        throw Error(locate_message(file, "malformed OBJ: " + reader.Error()));
+    if (!reader.Error().empty()) throw Error(locate_message(file, "malformed OBJ: " + reader.Error()));
+
+    const tinyobj::attrib_t& attrib = reader.GetAttrib();
+    const auto& shapes = reader.GetShapes();
+    const auto& materials = reader.GetMaterials();
+    const int nv = int(attrib.vertices.size() / 3);
+    const int nn = int(attrib.normals.size() / 3);
+    const int nt = int(attrib.texcoords.size() / 2);
+
+    Scene scene;
+    scene.name = path.stem().string();
+    scene.source = file;
+    if (reader.Warning().find("not found") != std::string::npos)
+        scene.warnings.push_back(file + ": material library not found; using the default material");
+
+    bool rescaled = false, textured = false;
+    for (const auto& m : materials) {
+        scene.materials.push_back(convert_material(m, rescaled));
+        textured |= !m.diffuse_texname.empty() || !m.specular_texname.empty();
+    }
+    if (rescaled) scene.warnings.push_back(file + ": Kd + Ks > 1 in some materials; Ks scaled down to conserve energy");
+    if (textured) scene.warnings.push_back(file + ": textures are not used; the MTL colours stand in for them");
+
+    // Index checks first, with the OBJ line of the offending face.
+    size_t face_ordinal = 0;
+    bool all_normals = nn > 0, all_uvs = nt > 0;
+    for (const auto& shape : shapes) {
+        size_t offset = 0;
+        for (size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f, ++face_ordinal) {
+            const size_t corners = shape.mesh.num_face_vertices[f];
+            if (offset + corners > shape.mesh.indices.size())
+                throw Error(file, "inconsistent face data (parser error)");
+            auto where = [&]() {
+                return face_ordinal < scan.face_lines.size()
+                           ? file + ":" + std::to_string(scan.face_lines[face_ordinal])
+                           : file;
+            };
+            for (size_t k = 0; k < corners; ++k) {
+                const tinyobj::index_t& idx = shape.mesh.indices[offset + k];
+                if (idx.vertex_index < 0 || idx.vertex_index >= nv)
+                    throw Error(where(), "face references vertex " + std::to_string(idx.vertex_index + 1) +
+                                             " but the file has " + std::to_string(nv) +
+                                             " vertices (index out of range)");
+                if (idx.normal_index >= nn || idx.normal_index < -1)
+                    throw Error(where(), "face references normal " + std::to_string(idx.normal_index + 1) +
+                                             " but the file has " + std::to_string(nn) +
+                                             " normals (index out of range)");
+                if (idx.texcoord_index >= nt || idx.texcoord_index < -1)
+                    throw Error(where(), "face references texture coordinate " +
+                                             std::to_string(idx.texcoord_index + 1) + " but the file has " +
+                                             std::to_string(nt) + " (index out of range)");
+                all_normals &= idx.normal_index >= 0;
+                all_uvs &= idx.texcoord_index >= 0;
+            }
+            const int mat = f < shape.mesh.material_ids.size() ? shape.mesh.material_ids[f] : -1;
+            if (mat >= int(materials.size())) throw Error(where(), "face uses an unknown material");
+            offset += corners;
+        }
+    }
+
+    Mesh mesh;
+    mesh.name = scene.name;
+    uint32_t default_material = UINT32_MAX;
+    auto material_of = [&](int id) -> uint32_t {
+        if (id >= 0) return uint32_t(id);
+        if (default_material == UINT32_MAX) {
+            default_material = uint32_t(scene.materials.size());
+            scene.materials.push_back(Material{});
+        }
+        return default_material;
+    };
+
+    // Without per-corner normals/uvs the OBJ position indices are used as they are;
+    // otherwise every distinct (position, normal, uv) corner becomes one vertex.
+    const bool split_corners = all_normals || all_uvs;
+    std::unordered_map<CornerKey, uint32_t, CornerHash> corner_index;
+    if (!split_corners) {
+        mesh.positions.resize(size_t(nv));
+        for (int i = 0; i < nv; ++i) mesh.positions[size_t(i)] = to_vec3(&attrib.vertices[3 * size_t(i)]);
+    }
+    auto vertex_of = [&](const tinyobj::index_t& idx) -> uint32_t {
+        if (!split_corners) return uint32_t(idx.vertex_index);
+        CornerKey key{idx.vertex_index, all_normals ? idx.normal_index : -1, all_uvs ? idx.texcoord_index : -1};
+        auto [it, inserted] = corner_index.try_emplace(key, uint32_t(mesh.positions.size()));
+        if (inserted) {
+            mesh.positions.push_back(to_vec3(&attrib.vertices[3 * size_t(key.v)]));
+            if (all_normals) mesh.normals.push_back(to_vec3(&attrib.normals[3 * size_t(key.n)]));
+            if (all_uvs)
+                mesh.uvs.emplace_back(attrib.texcoords[2 * size_t(key.t)], attrib.texcoords[2 * size_t(key.t) + 1]);
+        }
+        return it->second;
+    };
+
+    for (const auto& shape : shapes) {
+        size_t offset = 0;
+        for (size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f) {
+            const size_t corners = shape.mesh.num_face_vertices[f];
+            const uint32_t mat = material_of(f < shape.mesh.material_ids.size() ? shape.mesh.material_ids[f] : -1);
+            const uint32_t first = vertex_of(shape.mesh.indices[offset]);
+            uint32_t prev = vertex_of(shape.mesh.indices[offset + 1]);
+            for (size_t k = 2; k < corners; ++k) {  // fan: (0, k-1, k)
+                const uint32_t cur = vertex_of(shape.mesh.indices[offset + k]);
+                mesh.triangles.emplace_back(first, prev, cur);
+                mesh.material_ids.push_back(mat);
+                prev = cur;
+            }
+            offset += corners;
+        }
+    }
+    // Zero-length normals (seen in exported files) are dropped with the whole set.
+    for (const Vec3& n : mesh.normals)
+        if (!(glm::dot(n, n) > 0.0f)) {
+            mesh.normals.clear();
+            scene.warnings.push_back(file + ": zero-length vertex normals; using flat shading");
+            break;
+        }
+    for (Vec3& n : mesh.normals) n = glm::normalize(n);
+
+    if (mesh.triangles.empty()) throw Error(file, "no faces (empty or truncated OBJ)");
+    scene.degenerate_triangles_dropped += validate_and_clean(mesh, scene.materials.size(), file).degenerate_triangles_dropped;
+    scene.add_mesh_instance(std::move(mesh));
+    return scene;
+}
+
+}  // namespace gilab

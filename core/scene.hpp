@@ -1,0 +1,89 @@
+#pragma once
+// The scene: meshes in local space placed by a node hierarchy (with optional keyframed
+// TRS animation), materials, punctual lights, and optionally a camera or HMD rig.
+// `evaluate(t)` flattens it into world space for the ray tracer and the techniques.
+#include <optional>
+#include <string>
+#include <vector>
+#include "core/animation.hpp"
+#include "core/camera.hpp"
+#include "core/hmd.hpp"
+#include "core/light.hpp"
+#include "core/material.hpp"
+#include "core/mesh.hpp"
+
+namespace gilab {
+
+struct SceneNode {
+    std::string name;
+    int parent = -1;                 // index of an earlier node, or -1 for a root
+    Transform local;                 // rest pose
+    TrsAnimation animation;          // empty = static
+    std::vector<uint32_t> meshes;    // indices into Scene::meshes
+};
+
+struct SceneCamera {
+    Vec3 position{0, 0, 1};
+    Vec3 target{0};
+    Vec3 up{0, 1, 0};
+    float vertical_fov_degrees = 45.0f;
+};
+
+struct SceneHmd {
+    std::string preset = "vive";
+    HeadPose pose;
+    std::optional<float> ipd;  // overrides the preset's IPD
+};
+
+// One mesh instance in world space at a given time.
+struct WorldMesh {
+    uint32_t source_mesh = 0;
+    uint32_t node = 0;
+    std::vector<Vec3> positions;
+    std::vector<Vec3> normals;       // empty if the source mesh has none
+    std::vector<UVec3> triangles;
+    std::vector<uint32_t> material_ids;
+};
+
+struct SceneFrame {
+    double time = 0;
+    std::vector<WorldMesh> meshes;
+    std::vector<PunctualLight> lights;  // in world space
+    Bounds3 bounds;
+    size_t triangle_count() const;
+};
+
+struct Scene {
+    std::string name;
+    std::string source;              // file it was loaded from, or "builtin:NAME"
+    std::vector<Material> materials;
+    std::vector<Mesh> meshes;
+    std::vector<SceneNode> nodes;    // parents come before children
+    std::vector<PunctualLight> lights;  // in the space of their node (world if node = -1)
+    std::optional<SceneCamera> camera;
+    std::optional<SceneHmd> hmd;
+    double frames_per_second = 30.0;
+    size_t degenerate_triangles_dropped = 0;  // reported by loaders
+    std::vector<std::string> warnings;        // non-fatal loader notes (unsupported features)
+
+    // Adds a root node holding the given mesh and returns the node index.
+    uint32_t add_mesh_instance(Mesh mesh, const Transform& transform = {});
+
+    bool is_animated() const;
+    double animation_duration() const;     // seconds; 0 for a static scene
+    int animation_frame_count() const;     // frames at frames_per_second, ≥ 1
+    size_t triangle_count() const;         // over all instances
+    bool has_emitters() const;             // any emissive triangle or punctual light
+
+    // World-space geometry and lights at time t (seconds) / at frame k.
+    SceneFrame evaluate(double time) const;
+    SceneFrame evaluate_frame(int frame) const { return evaluate(frame / frames_per_second); }
+    // World transform of every node at time t.
+    std::vector<Mat4> node_transforms(double time) const;
+
+    // Throws Error naming `source` if the scene cannot be rendered: no geometry,
+    // dangling mesh/material/parent indices.
+    void validate() const;
+};
+
+}  // namespace gilab

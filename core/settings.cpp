@@ -1,0 +1,46 @@
+#include "core/settings.hpp"
+
+#include <sstream>
+#include "core/rng.hpp"
+
+namespace gilab {
+
+Settings::Settings(nlohmann::json values, std::string context)
+    : values_(std::move(values)), context_(std::move(context)) {
+    if (values_.is_null()) values_ = nlohmann::json::object();
+    if (!values_.is_object()) throw Error(context_, "settings must be a JSON object, got " + values_.dump());
+}
+
+void Settings::set_from_string(const std::string& assignment) {
+    auto eq = assignment.find('=');
+    if (eq == std::string::npos || eq == 0)
+        throw Error(context_, "setting '" + assignment + "' is not of the form key=value");
+    std::string key = assignment.substr(0, eq);
+    std::string text = assignment.substr(eq + 1);
+    auto parsed = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+    values_[key] = parsed.is_discarded() ? nlohmann::json(text) : parsed;
+}
+
+void Settings::report_unused() const {
+    std::vector<std::string> unused;
+    for (auto it = values_.begin(); it != values_.end(); ++it)
+        if (!read_.count(it.key())) unused.push_back(it.key());
+    if (unused.empty()) return;
+    std::ostringstream msg;
+    msg << (unused.size() == 1 ? "unknown setting " : "unknown settings ");
+    for (size_t i = 0; i < unused.size(); ++i) msg << (i ? ", '" : "'") << unused[i] << "'";
+    msg << " (misspelt, or not used by this technique)";
+    throw Error(context_, msg.str());
+}
+
+std::string Settings::hash() const {
+    // nlohmann::json objects are ordered by key, so dump() is canonical.
+    std::string text = values_.dump();
+    uint64_t h = 0xcbf29ce484222325ull;
+    for (unsigned char c : text) h = (h ^ c) * 0x100000001b3ull;
+    std::ostringstream out;
+    out << std::hex << mix64(h);
+    return out.str();
+}
+
+}  // namespace gilab

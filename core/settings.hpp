@@ -1,0 +1,58 @@
+#pragma once
+// A dictionary of settings (from JSON or CLI "key=value" pairs) that remembers which keys
+// were read, so misspelt or unsupported keys are reported instead of silently ignored.
+#include <set>
+#include <string>
+#include <nlohmann/json.hpp>
+#include "core/error.hpp"
+
+namespace gilab {
+
+class Settings {
+public:
+    Settings() : values_(nlohmann::json::object()) {}
+    explicit Settings(nlohmann::json values, std::string context = "settings");
+
+    // Parses "key=value"; value is read as JSON if it parses (numbers, true/false,
+    // arrays), else as a string.
+    void set_from_string(const std::string& assignment);
+    template <typename T>
+    void set(const std::string& key, const T& value) { values_[key] = value; }
+
+    bool has(const std::string& key) const { return values_.contains(key); }
+
+    template <typename T>
+    T get(const std::string& key, const T& fallback) const {
+        read_.insert(key);
+        if (!values_.contains(key)) return fallback;
+        return convert<T>(key);
+    }
+    template <typename T>
+    T require(const std::string& key) const {
+        read_.insert(key);
+        if (!values_.contains(key)) throw Error(context_, "missing setting '" + key + "'");
+        return convert<T>(key);
+    }
+
+    // Throws Error listing every key that was never read.
+    void report_unused() const;
+    const nlohmann::json& json() const { return values_; }
+    const std::string& context() const { return context_; }
+    // Stable hash of the settings (for provenance: identical settings ⇒ identical hash).
+    std::string hash() const;
+
+private:
+    template <typename T>
+    T convert(const std::string& key) const {
+        try {
+            return values_.at(key).get<T>();
+        } catch (const nlohmann::json::exception&) {
+            throw Error(context_, "setting '" + key + "' has the wrong type: " + values_.at(key).dump());
+        }
+    }
+    nlohmann::json values_;
+    std::string context_ = "settings";
+    mutable std::set<std::string> read_;
+};
+
+}  // namespace gilab

@@ -1,0 +1,43 @@
+#include "core/stats.hpp"
+
+#include <fstream>
+#include <sstream>
+
+namespace gilab {
+
+double Stats::get(const std::string& key, double fallback) const {
+    auto it = values_.find(key);
+    return it == values_.end() ? fallback : it->second;
+}
+
+void Stats::merge(const Stats& other, const std::string& prefix) {
+    for (const auto& [k, v] : other.values_) values_[prefix + k] += v;
+}
+
+nlohmann::json Stats::to_json() const {
+    nlohmann::json j = nlohmann::json::object();
+    for (const auto& [k, v] : values_) j[k] = v;
+    return j;
+}
+
+namespace {
+size_t read_status_kib(const char* field) {
+    std::ifstream status("/proc/self/status");
+    std::string line;
+    const std::string prefix = std::string(field) + ":";
+    while (std::getline(status, line)) {
+        if (line.rfind(prefix, 0) == 0) {
+            std::istringstream in(line.substr(prefix.size()));
+            size_t kib = 0;
+            in >> kib;
+            return kib;
+        }
+    }
+    return 0;
+}
+}  // namespace
+
+size_t peak_rss_bytes() { return read_status_kib("VmHWM") * 1024; }
+size_t current_rss_bytes() { return read_status_kib("VmRSS") * 1024; }
+
+}  // namespace gilab

@@ -1,0 +1,54 @@
+#pragma once
+// Named figures a run reports (timings, counters, bytes), plus a scoped wall-clock timer
+// and the process's peak resident memory.
+#include <chrono>
+#include <map>
+#include <string>
+#include <nlohmann/json.hpp>
+
+namespace gilab {
+
+class Stats {
+public:
+    void set(const std::string& key, double value) { values_[key] = value; }
+    void add(const std::string& key, double value) { values_[key] += value; }
+    double get(const std::string& key, double fallback = 0) const;
+    bool has(const std::string& key) const { return values_.count(key) != 0; }
+    const std::map<std::string, double>& values() const { return values_; }
+    void merge(const Stats& other, const std::string& prefix = "");
+    nlohmann::json to_json() const;
+
+private:
+    std::map<std::string, double> values_;
+};
+
+class ScopedTimer {
+public:
+    // Adds the elapsed milliseconds to stats[key] when destroyed.
+    ScopedTimer(Stats& stats, std::string key) : stats_(&stats), key_(std::move(key)) {}
+    ~ScopedTimer() { stats_->add(key_, elapsed_ms()); }
+    double elapsed_ms() const {
+        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count();
+    }
+
+private:
+    Stats* stats_;
+    std::string key_;
+    std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+class Stopwatch {
+public:
+    double elapsed_ms() const {
+        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count();
+    }
+    void reset() { start_ = std::chrono::steady_clock::now(); }
+
+private:
+    std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+size_t peak_rss_bytes();      // VmHWM of this process
+size_t current_rss_bytes();   // VmRSS of this process
+
+}  // namespace gilab

@@ -1,0 +1,66 @@
+#pragma once
+// An experiment reproduces one table or figure: it runs the code, returns tables of our
+// figures (with the paper's published figures in clearly labelled "paper ..." columns),
+// and the runner writes them to results/NAME/ atomically.
+#include <filesystem>
+#include <functional>
+#include <ostream>
+#include <string>
+#include <vector>
+#include <nlohmann/json.hpp>
+#include "core/asset_paths.hpp"
+
+namespace gilab {
+
+struct ExperimentContext {
+    bool quick = false;                       // small sizes for smoke runs
+    std::filesystem::path output_dir;         // results/NAME (created by the runner)
+    AssetPaths assets;
+    uint64_t seed = 1;
+    int threads = 0;                          // 0 = all cores
+    std::ostream* log = nullptr;              // progress messages (may be null)
+    void say(const std::string& message) const;
+};
+
+// One table. Rows are JSON objects keyed by column name. Columns whose name starts with
+// "paper" hold the published figures (reference data), everything else is measured.
+struct ResultTable {
+    std::string title;
+    std::vector<std::string> columns;
+    std::vector<nlohmann::json> rows;
+};
+
+struct ExperimentOutput {
+    std::vector<ResultTable> tables;     // tables[0] goes to results.csv
+    nlohmann::json config = nlohmann::json::object();  // effective configuration
+    std::vector<std::string> notes;      // printed under the tables in table.md
+    std::vector<std::string> files;      // extra outputs written (images), relative names
+};
+
+struct Experiment {
+    std::string name;          // e.g. "core-rays", "pm-table1"
+    std::string paper;         // "P1", "P2", "P3" or "core"
+    std::string description;
+    std::function<ExperimentOutput(const ExperimentContext&)> run;
+};
+
+class ExperimentRegistry {
+public:
+    void add(Experiment experiment);
+    const Experiment* find(const std::string& name) const;
+    const Experiment& get(const std::string& name) const;  // throws Error listing names
+    const std::vector<Experiment>& list() const { return experiments_; }
+    static const ExperimentRegistry& builtin();  // registered in experiments/registry.cpp
+
+private:
+    std::vector<Experiment> experiments_;
+};
+
+// Runs the experiment and writes results.csv, results.json (figures, configuration, git
+// revision, seed, machine) and table.md into context.output_dir. Returns the output.
+ExperimentOutput run_and_write(const Experiment& experiment, ExperimentContext context);
+
+// Registration functions, one per paper/module (called from registry.cpp only).
+void register_core_experiments(ExperimentRegistry& registry);
+
+}  // namespace gilab

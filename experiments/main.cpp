@@ -1,0 +1,149 @@
+// The gilab command line: render, info, list, experiment.
+#include <CLI/CLI.hpp>
+#include <iostream>
+#include "core/error.hpp"
+#include "core/hmd.hpp"
+#include "core/parallel.hpp"
+#include "experiments/experiment.hpp"
+#include "experiments/render_command.hpp"
+#include "scenes/builtin_scenes.hpp"
+#include "scenes/scene_library.hpp"
+#include "techniques/technique.hpp"
+
+using namespace gilab;
+
+namespace {
+
+void print_list(const std::string& what) {
+    bool all = what.empty();
+    if (all || what == "techniques") {
+        std::cout << "techniques:\n";
+        for (const auto& t : TechniqueRegistry::builtin().list()) std::cout << "  " << t.name << " — " << t.description << "\n";
+    }
+    if (all || what == "experiments") {
+        std::cout << "experiments:\n";
+        for (const auto& e : ExperimentRegistry::builtin().list())
+            std::cout << "  " << e.name << " [" << e.paper << "] — " << e.description << "\n";
+    }
+    if (all || what == "scenes") {
+        std::cout << "scenes (built in):\n";
+        for (const auto& s : builtin_scenes()) std::cout << "  " << s.name << " — " << s.description << "\n";
+        std::cout << "scenes (files in " << scenes_directory() << "):\n";
+        for (const auto& n : scene_file_names()) std::cout << "  " << n << "\n";
+    }
+    if (all || what == "hmds") {
+        std::cout << "HMD presets:\n";
+        for (const auto& p : hmd_presets())
+            std::cout << "  " << p.name << " — " << p.display_name << ", " << p.width << "×" << p.height
+                      << " per eye, IPD " << p.ipd * 1000 << " mm (" << p.source << ")\n";
+    }
+}
+
+int run_experiments(const std::vector<std::string>& names, bool quick, const std::string& results, uint64_t seed,
+                    int threads, const AssetPaths& assets) {
+    const ExperimentRegistry& registry = ExperimentRegistry::builtin();
+    std::vector<const Experiment*> selected;
+    for (const auto& name : names) {
+        if (name == "all") {
+            for (const auto& e : registry.list()) selected.push_back(&e);
+        } else {
+            selected.push_back(&registry.get(name));  // throws on an unknown name, before running anything
+        }
+    }
+    int failures = 0;
+    for (const Experiment* e : selected) {
+        ExperimentContext ctx;
+        ctx.quick = quick;
+        ctx.output_dir = std::filesystem::path(results) / e->name;
+        ctx.assets = assets;
+        ctx.seed = seed;
+        ctx.threads = threads;
+        ctx.log = &std::cout;
+        std::cout << "experiment " << e->name << (quick ? " (quick)" : "") << ": " << e->description << std::endl;
+        try {
+            run_and_write(*e, ctx);
+            std::cout << "  wrote " << (ctx.output_dir / "table.md").string() << std::endl;
+        } catch (const Error& err) {
+            std::cerr << "gilab: experiment " << e->name << " failed: " << err.what() << std::endl;
+            ++failures;
+        }
+    }
+    return failures ? 1 : 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"gilab — global illumination research framework (photon mapping for HMDs, sparse voxel DAGs, "
+                 "cascaded voxel cone tracing, reference path tracer)"};
+    app.require_subcommand(1);
+    int threads = 0;
+    std::string assets_flag;
+    app.add_option("--threads", threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+    app.add_option("--assets", assets_flag,
+                   "asset search path, colon-separated (also $GILAB_ASSETS; default ../shared/scenes beside the source)");
+
+    RenderRequest request;
+    uint64_t seed = 1;
+    auto* render = app.add_subcommand("render", "render a scene with a technique (mono, or stereo with --hmd)");
+    render->add_option("scene", request.scene, "built-in name, scene file name in scenes/, or a path")->capture_default_str();
+    render->add_option("-t,--technique", request.technique, "technique name (see `gilab list techniques`)")->capture_default_str();
+    render->add_option("--hmd", request.hmd, "render a stereo pair with this HMD preset (see `gilab list hmds`)");
+    render->add_option("--ipd", request.ipd, "inter-pupillary distance in metres (overrides the preset)");
+    render->add_option("-W,--width", request.width, "image (per-eye) width in pixels");
+    render->add_option("-H,--height", request.height, "image (per-eye) height in pixels");
+    render->add_option("--spp", request.spp, "samples per pixel");
+    render->add_option("--seed", seed, "random seed")->capture_default_str();
+    render->add_option("--time", request.time, "scene time in seconds (animated scenes)");
+    render->add_option("-o,--output", request.output, "output path without extension (writes .exr and .png)");
+    render->add_option("--settings", request.settings_file, "technique settings as a JSON object file");
+    render->add_option("--set", request.assignments, "technique setting key=value (repeatable)");
+    render->add_option("--exposure", request.exposure, "PNG preview exposure in stops");
+
+    std::string info_scene;
+    auto* info = app.add_subcommand("info", "describe a scene: triangles, materials, lights, bounds, animation, closed meshes");
+    info->add_option("scene", info_scene, "scene name or path")->required();
+
+    std::string list_what;
+    auto* list = app.add_subcommand("list", "list techniques, experiments, scenes and HMD presets");
+    list->add_option("what", list_what, "one of techniques, experiments, scenes, hmds")
+        ->check(CLI::IsMember({"techniques", "experiments", "scenes", "hmds"}));
+
+    std::vector<std::string> experiment_names;
+    bool quick = false;
+    std::string results_dir = "results";
+    auto* experiment = app.add_subcommand("experiment", "run experiments: `list`, a name, several names, or `all`");
+    experiment->add_option("names", experiment_names, "experiment names, `all`, or `list`")->required();
+    experiment->add_flag("--quick", quick, "small sizes (smoke run, minutes)");
+    experiment->add_option("--results", results_dir, "results root directory")->capture_default_str();
+    experiment->add_option("--seed", seed, "random seed")->capture_default_str();
+
+    CLI11_PARSE(app, argc, argv);
+
+    try {
+        ThreadLimit limit(threads);
+        AssetPaths assets = AssetPaths::from_environment(assets_flag.empty() ? std::nullopt : std::optional(assets_flag));
+        if (*render) {
+            request.seed = seed;
+            request.assets = assets;
+            run_render(request);
+        } else if (*info) {
+            std::cout << describe_scene(info_scene, assets);
+        } else if (*list) {
+            print_list(list_what);
+        } else if (*experiment) {
+            if (experiment_names.size() == 1 && experiment_names[0] == "list") {
+                print_list("experiments");
+                return 0;
+            }
+            return run_experiments(experiment_names, quick, results_dir, seed, threads, assets);
+        }
+    } catch (const Error& e) {
+        std::cerr << "gilab: error: " << e.what() << std::endl;
+        return 1;
+    } catch (const std::exception& e) {
+        std::cerr << "gilab: internal error: " << e.what() << std::endl;
+        return 2;
+    }
+    return 0;
+}

@@ -1,0 +1,14 @@
+#include "experiments/experiment.hpp"
+
+namespace gilab {
+
+const ExperimentRegistry& ExperimentRegistry::builtin() {
+    static const ExperimentRegistry registry = [] {
+        ExperimentRegistry r;
+        register_core_experiments(r);
+        return r;
+    }();
+    return registry;
+}
+
+}  // namespace gilab

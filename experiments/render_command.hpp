@@ -1,0 +1,32 @@
+#pragma once
+// `gilab render`: one scene, one technique, a mono camera or an HMD stereo pair.
+#include <optional>
+#include <string>
+#include <vector>
+#include "core/asset_paths.hpp"
+
+namespace gilab {
+
+struct RenderRequest {
+    std::string scene = "cornell";
+    std::string technique = "path";
+    std::optional<std::string> hmd;   // preset name → stereo
+    std::optional<float> ipd;
+    std::optional<int> width, height; // default: preset's per-eye size, or 512×512 mono
+    std::optional<int> spp;
+    uint64_t seed = 1;
+    double time = 0;
+    std::string output;               // path without extension; default results/render/SCENE_TECHNIQUE
+    std::optional<std::string> settings_file;
+    std::vector<std::string> assignments;  // key=value
+    float exposure = 0;
+    AssetPaths assets;
+};
+
+// Renders and writes OUTPUT.exr and OUTPUT.png; returns the paths written.
+std::vector<std::string> run_render(const RenderRequest& request);
+
+// `gilab info`: a human-readable summary of a scene.
+std::string describe_scene(const std::string& spec, const AssetPaths& assets);
+
+}  // namespace gilab

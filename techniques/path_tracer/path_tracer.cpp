@@ -1,0 +1,285 @@
+#include "techniques/path_tracer/path_tracer.hpp"
+
+#include <atomic>
+#include <cmath>
+#include <sstream>
+#include "core/bsdf.hpp"
+#include "core/error.hpp"
+#include "core/interaction.hpp"
+#include "core/parallel.hpp"
+#include "core/progress.hpp"
+#include "core/rng.hpp"
+
+#ifndef GILAB_GIT_REVISION
+#define GILAB_GIT_REVISION "unknown"
+#endif
+
+namespace gilab {
+
+namespace {
+
+// What one camera sample contributes to every layer.
+struct PathSample {
+    Vec3 direct{0}, indirect{0};
+    Vec3 albedo{0}, normal{0};
+    float depth = 0;
+    bool hit = false;
+};
+
+// Adds a contribution that reached the eye after `bounces` scattering events.
+void add_light(PathSample& s, int bounces, const Vec3& value) {
+    (bounces <= 1 ? s.direct : s.indirect) += value;
+}
+
+bool is_black(const Vec3& v) { return v.x <= 0.0f && v.y <= 0.0f && v.z <= 0.0f; }
+
+// A shadow ray from a surface towards a light sample, stopping just short of it.
+Ray shadow_ray(const SurfaceInteraction& si, const LightSample& ls) {
+    Ray r;
+    r.origin = si.spawn_origin(ls.wi);
+    r.direction = ls.wi;
+    if (std::isinf(ls.distance)) return r;
+    Vec3 target = si.position + ls.distance * ls.wi;
+    float dist = glm::length(target - r.origin);
+    r.tmax = std::max(0.0f, dist - ray_epsilon(target));
+    return r;
+}
+
+std::string format_number(double v) {
+    std::ostringstream out;
+    out.precision(9);
+    out << v;
+    return out.str();
+}
+
+}  // namespace
+
+PathTracerSettings PathTracerSettings::from(const Settings& s) {
+    PathTracerSettings p;
+    const std::string& where = s.context();
+    p.spp = s.get<int>("spp", p.spp);
+    int64_t seed = s.get<int64_t>("seed", int64_t(p.seed));
+    p.max_depth = s.get<int>("max_depth", p.max_depth);
+    p.rr_depth = s.get<int>("rr_depth", p.rr_depth);
+    p.tile_size = s.get<int>("tile_size", p.tile_size);
+    p.jitter = s.get<bool>("jitter", p.jitter);
+    if (p.spp < 1) throw Error(where, "setting 'spp' must be at least 1, got " + std::to_string(p.spp));
+    if (seed < 0) throw Error(where, "setting 'seed' must not be negative, got " + std::to_string(seed));
+    if (p.max_depth < 0) throw Error(where, "setting 'max_depth' must not be negative, got " + std::to_string(p.max_depth));
+    if (p.rr_depth < 0) throw Error(where, "setting 'rr_depth' must not be negative, got " + std::to_string(p.rr_depth));
+    if (p.tile_size < 1) throw Error(where, "setting 'tile_size' must be at least 1, got " + std::to_string(p.tile_size));
+    p.seed = uint64_t(seed);
+    return p;
+}
+
+void PathTracer::prepare(const Scene& scene, const Settings& settings) {
+    Stopwatch watch;
+    settings_ = PathTracerSettings::from(settings);
+    config_hash_ = settings.hash();
+    scene.validate();
+    materials_ = scene.materials;
+    if (scene.is_animated())
+        animated_scene_ = scene;
+    else
+        animated_scene_.reset();
+    tracer_.reset();
+    frame_ = scene.evaluate(0.0);
+    tracer_ = std::make_unique<RayTracer>(frame_);
+    lights_ = LightSampler(frame_, materials_);
+    stats_ = Stats();
+    stats_.set("prepare_ms", watch.elapsed_ms());
+    stats_.set("triangles", double(frame_.triangle_count()));
+    stats_.set("lights", double(lights_.light_count()));
+}
+
+void PathTracer::update(double time) {
+    if (!tracer_) throw Error("path", "update() called before prepare()");
+    if (!animated_scene_) return;  // static: every time looks the same
+    Stopwatch watch;
+    frame_ = animated_scene_->evaluate(time);
+    RayTracer::UpdateKind kind = tracer_->update(frame_);
+    lights_ = LightSampler(frame_, materials_);
+    stats_.set("update_ms", watch.elapsed_ms());
+    stats_.set("bvh_rebuilt", kind == RayTracer::UpdateKind::Rebuild ? 1.0 : 0.0);
+}
+
+namespace {
+
+struct Tracer {
+    const RayTracer& tracer;
+    const SceneFrame& frame;
+    const std::vector<Material>& materials;
+    const LightSampler& lights;
+    const PathTracerSettings& settings;
+
+    PathSample trace(Ray ray, Rng& rng, uint64_t& rays) const {
+        PathSample out;
+        Vec3 beta(1.0f);
+        float prev_pdf = 0.0f;
+        Vec3 prev_position(0.0f);
+        for (int depth = 0;; ++depth) {
+            Hit hit = tracer.intersect(ray);
+            ++rays;
+            if (!hit.valid()) break;  // no environment light: escaped paths carry nothing
+            SurfaceInteraction si = make_interaction(frame, ray, hit);
+            const Material& m = materials[si.material];
+            if (depth == 0) {
+                out.hit = true;
+                out.albedo = m.albedo + m.specular;
+                out.normal = si.shading_normal;
+                out.depth = hit.t * glm::length(ray.direction);
+            }
+
+            // Emission reached by BSDF sampling (or seen directly), weighted against NEE.
+            if (m.is_emissive() && !si.back_face) {
+                float w = 1.0f;
+                if (depth > 0) {
+                    float light_pdf = lights.pdf_incident(prev_position, si.mesh, si.triangle, si.position);
+                    w = power_heuristic(prev_pdf, light_pdf);
+                }
+                add_light(out, depth, beta * m.emission * w);
+            }
+            if (depth >= settings.max_depth) break;
+
+            const Vec3& n = si.shading_normal;
+            // Next-event estimation.
+            if (!lights.empty()) {
+                LightSample ls = lights.sample_incident(si.position, rng);
+                if (ls.pdf > 0.0f && !is_black(ls.Li) && glm::dot(ls.wi, si.geometric_normal) > 0.0f) {
+                    Vec3 f = bsdf_eval(m, n, si.wo, ls.wi);
+                    if (!is_black(f)) {
+                        ++rays;
+                        if (!tracer.occluded(shadow_ray(si, ls))) {
+                            float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf(m, n, si.wo, ls.wi));
+                            float cos_i = glm::dot(n, ls.wi);
+                            add_light(out, depth + 1, beta * f * ls.Li * (cos_i * w / ls.pdf));
+                        }
+                    }
+                }
+            }
+
+            // Continue the path by sampling the BSDF.
+            BsdfSample bs = bsdf_sample(m, n, si.wo, rng);
+            if (!bs.valid || glm::dot(bs.wi, si.geometric_normal) <= 0.0f) break;
+            beta *= bs.weight;
+            prev_pdf = bs.pdf;
+            prev_position = si.position;
+            if (depth + 1 >= settings.rr_depth) {
+                float q = std::min(max_component(beta), 0.95f);
+                if (!(q > 0.0f) || rng.uniform() >= q) break;
+                beta /= q;
+            }
+            ray = Ray{si.spawn_origin(bs.wi), bs.wi};
+        }
+        return out;
+    }
+};
+
+}  // namespace
+
+void PathTracer::render(const ViewSet& views, std::vector<Film>& films) {
+    if (!tracer_) throw Error("path", "render() called before prepare()");
+    Stopwatch watch;
+    const Tracer tracer{*tracer_, frame_, materials_, lights_, settings_};
+    std::atomic<uint64_t> rays{0}, dropped{0};
+    films.resize(views.views.size());
+    double samples = 0;
+
+    for (size_t v = 0; v < views.views.size(); ++v) {
+        const EyeCamera& camera = views.views[v];
+        const int width = camera.width(), height = camera.height();
+        check_resolution(width, height, 6);
+        Film film(width, height);
+        film.add_layer("direct");
+        film.add_layer("indirect");
+        film.add_layer("albedo");
+        film.add_layer("normal");
+        film.add_layer("depth", 1);
+        float* color = film.layer("color").data.data();
+        float* direct = film.layer("direct").data.data();
+        float* indirect = film.layer("indirect").data.data();
+        float* albedo = film.layer("albedo").data.data();
+        float* normal = film.layer("normal").data.data();
+        float* depth = film.layer("depth").data.data();
+
+        const int ts = settings_.tile_size;
+        size_t tiles = size_t((width + ts - 1) / ts) * size_t((height + ts - 1) / ts);
+        std::string label = "path";
+        if (views.views.size() > 1 && v < views.names.size()) label += " " + views.names[v];
+        Progress progress(label, tiles);
+        const int spp = settings_.spp;
+        const float inv_spp = 1.0f / float(spp);
+
+        parallel_for_tiles(width, height, ts, [&](const Tile& tile) {
+            uint64_t tile_rays = 0, tile_dropped = 0;
+            for (int y = tile.y0; y < tile.y1; ++y) {
+                for (int x = tile.x0; x < tile.x1; ++x) {
+                    const size_t pixel = size_t(y) * size_t(width) + size_t(x);
+                    // Samples are summed in order by this one task: thread count never
+                    // changes the floating-point result.
+                    Vec3 sum_direct(0), sum_indirect(0), sum_albedo(0), sum_normal(0);
+                    float sum_depth = 0;
+                    int hits = 0;
+                    for (int s = 0; s < spp; ++s) {
+                        Rng rng = Rng::for_sample(settings_.seed, pixel, uint64_t(s), uint64_t(v));
+                        Vec2 jitter = settings_.jitter ? rng.uniform2() : Vec2(0.5f);
+                        Ray ray = camera.generate_ray(float(x) + jitter.x, float(y) + jitter.y);
+                        PathSample ps = tracer.trace(ray, rng, tile_rays);
+                        if (!is_finite(ps.direct) || !is_finite(ps.indirect)) {
+                            ++tile_dropped;  // counted and reported, never averaged in
+                            continue;
+                        }
+                        sum_direct += ps.direct;
+                        sum_indirect += ps.indirect;
+                        if (ps.hit) {
+                            sum_albedo += ps.albedo;
+                            sum_normal += ps.normal;
+                            sum_depth += ps.depth;
+                            ++hits;
+                        }
+                    }
+                    Vec3 d = sum_direct * inv_spp, i = sum_indirect * inv_spp;
+                    Vec3 c = d + i;
+                    Vec3 a = sum_albedo * inv_spp;
+                    Vec3 nrm = glm::length(sum_normal) > 0 ? glm::normalize(sum_normal) : Vec3(0);
+                    for (int k = 0; k < 3; ++k) {
+                        color[3 * pixel + k] = c[k];
+                        direct[3 * pixel + k] = d[k];
+                        indirect[3 * pixel + k] = i[k];
+                        albedo[3 * pixel + k] = a[k];
+                        normal[3 * pixel + k] = nrm[k];
+                    }
+                    depth[pixel] = hits > 0 ? sum_depth / float(hits) : 0.0f;
+                }
+            }
+            rays += tile_rays;
+            dropped += tile_dropped;
+            progress.advance();
+        });
+        progress.finish();
+        samples += double(width) * double(height) * double(spp);
+        film.metadata["technique"] = "path";
+        film.metadata["view"] = v < views.names.size() ? views.names[v] : "mono";
+        film.metadata["spp"] = std::to_string(spp);
+        film.metadata["seed"] = std::to_string(settings_.seed);
+        film.metadata["max_depth"] = std::to_string(settings_.max_depth);
+        film.metadata["rr_depth"] = std::to_string(settings_.rr_depth);
+        film.metadata["config_hash"] = config_hash_;
+        film.metadata["git_revision"] = GILAB_GIT_REVISION;
+        films[v] = std::move(film);
+    }
+    double ms = watch.elapsed_ms();
+    for (Film& film : films) film.metadata["render_time_seconds"] = format_number(ms / 1000.0);
+    stats_.set("render_ms", ms);
+    stats_.set("rays", double(rays.load()));
+    stats_.set("samples", samples);
+    stats_.set("nonfinite_samples", double(dropped.load()));
+}
+
+void register_path_tracer(TechniqueRegistry& registry) {
+    registry.add({"path",
+                  "reference unidirectional path tracer (next-event estimation + MIS, Russian roulette)",
+                  [] { return std::make_unique<PathTracer>(); }});
+}
+
+}  // namespace gilab

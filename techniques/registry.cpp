@@ -1,0 +1,38 @@
+#include "techniques/technique.hpp"
+
+#include "core/error.hpp"
+#include "techniques/path_tracer/path_tracer.hpp"
+
+namespace gilab {
+
+void TechniqueRegistry::add(TechniqueInfo info) {
+    if (info.name.empty()) throw Error("technique registry", "a technique needs a name");
+    if (!info.create) throw Error("technique registry", "technique '" + info.name + "' has no factory");
+    if (find(info.name)) throw Error("technique registry", "technique '" + info.name + "' is registered twice");
+    techniques_.push_back(std::move(info));
+}
+
+const TechniqueInfo* TechniqueRegistry::find(const std::string& name) const {
+    for (const TechniqueInfo& t : techniques_)
+        if (t.name == name) return &t;
+    return nullptr;
+}
+
+std::unique_ptr<Technique> TechniqueRegistry::create(const std::string& name) const {
+    if (const TechniqueInfo* info = find(name)) return info->create();
+    std::string known;
+    for (const TechniqueInfo& t : techniques_) known += (known.empty() ? "" : ", ") + t.name;
+    throw Error("technique '" + name + "'", "unknown technique (known: " + (known.empty() ? "none" : known) + ")");
+}
+
+const TechniqueRegistry& TechniqueRegistry::builtin() {
+    // One explicit line per technique: nothing depends on static initialisers.
+    static const TechniqueRegistry registry = [] {
+        TechniqueRegistry r;
+        register_path_tracer(r);
+        return r;
+    }();
+    return registry;
+}
+
+}  // namespace gilab

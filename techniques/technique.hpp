@@ -1,0 +1,63 @@
+#pragma once
+// The interface every global-illumination technique implements, and the registry the
+// CLI and the experiments use to look techniques up by name (never by type).
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+#include "core/camera.hpp"
+#include "core/film.hpp"
+#include "core/scene.hpp"
+#include "core/settings.hpp"
+#include "core/stats.hpp"
+
+namespace gilab {
+
+// The views rendered together: one (mono) or two (stereo: left, right).
+struct ViewSet {
+    std::vector<EyeCamera> views;
+    std::vector<std::string> names;  // "mono" or "left", "right"
+    bool stereo() const { return views.size() == 2; }
+    static ViewSet mono(const EyeCamera& camera) { return {{camera}, {"mono"}}; }
+    static ViewSet stereo_pair(const EyeCamera& left, const EyeCamera& right) {
+        return {{left, right}, {"left", "right"}};
+    }
+};
+
+class Technique {
+public:
+    virtual ~Technique() = default;
+    virtual std::string name() const = 0;
+    // Reads the technique's settings (every key it understands; the caller reports the
+    // rest as errors) and builds what it needs for the scene at time 0.
+    virtual void prepare(const Scene& scene, const Settings& settings) = 0;
+    // Moves a dynamic scene to time t (seconds). Static scenes may ignore it.
+    virtual void update(double time) = 0;
+    // Renders every view into films[i] (resized by the technique to the view's size).
+    virtual void render(const ViewSet& views, std::vector<Film>& films) = 0;
+    // Figures from the last prepare/update/render (timings in ms, counters, bytes).
+    virtual Stats stats() const = 0;
+};
+
+struct TechniqueInfo {
+    std::string name;
+    std::string description;
+    std::function<std::unique_ptr<Technique>()> create;
+};
+
+class TechniqueRegistry {
+public:
+    void add(TechniqueInfo info);
+    // Throws Error naming the unknown technique and listing the known ones.
+    std::unique_ptr<Technique> create(const std::string& name) const;
+    const TechniqueInfo* find(const std::string& name) const;
+    const std::vector<TechniqueInfo>& list() const { return techniques_; }
+
+    // All built-in techniques, registered explicitly in techniques/registry.cpp.
+    static const TechniqueRegistry& builtin();
+
+private:
+    std::vector<TechniqueInfo> techniques_;
+};
+
+}  // namespace gilab

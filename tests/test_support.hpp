@@ -1,0 +1,15 @@
+#pragma once
+// Shared helpers for tests: where the shared assets are, temp directories.
+#include <filesystem>
+#include <optional>
+#include <string>
+
+namespace gilab::test {
+
+// Path of an asset under the shared scenes directory, or nullopt if it is not there
+// (tests then GTEST_SKIP with a message naming the missing file).
+std::optional<std::filesystem::path> shared_asset(const std::string& relative);
+// A fresh empty directory under the build tree for this test's outputs.
+std::filesystem::path temp_dir(const std::string& name);
+
+}  // namespace gilab::test
