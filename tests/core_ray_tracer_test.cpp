@@ -54,21 +54,22 @@ TEST(RayTracer, ClosestHitMatchesBruteForceOnRandomRays) {
     Scene scene = make_cornell_box();
     SceneFrame frame = scene.evaluate(0);
     RayTracer tracer(frame);
-    int agree = 0, total = 0;
+    int agree = 0, hits = 0;
     for (const Ray& r : random_rays(frame.bounds, 2000, 1)) {
         double t;
         uint32_t mesh = 0, tri = 0;
         bool expected = brute_force_hit(frame, r, t, mesh, tri);
         Hit h = tracer.intersect(r);
-        ++total;
         ASSERT_EQ(h.valid(), expected);
         if (!expected) continue;
+        ++hits;
         EXPECT_NEAR(h.t, t, 1e-4 * std::max(1.0, t));
         // Ties at shared edges may pick either triangle; the distance must agree regardless.
         if (h.triangle == tri) ++agree;
         EXPECT_EQ(tracer.occluded(r), true);
     }
-    EXPECT_GT(agree, total * 95 / 100);
+    EXPECT_GT(hits, 500);  // the rays start inside the box: most must hit something
+    EXPECT_GT(agree, hits * 99 / 100);
 }
 
 TEST(RayTracer, StreamsEqualSingleRays) {

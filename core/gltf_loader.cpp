@@ -1,0 +1,693 @@
+// glTF 2.0 (.gltf / .glb) through tinygltf: node hierarchy, triangle meshes, metallic-
+// roughness materials mapped onto the Lambert + Phong model, KHR_lights_punctual and
+// node TRS animations.
+//
+// Units and conventions:
+//  * Light intensities are taken as they are: candela (lm/sr) for point/spot lights is
+//    used as W/sr, lux (lm/m²) for directional lights as W/m²; `color` multiplies it.
+//  * Base-colour and emissive textures are not sampled per texel; their mean linear
+//    colour multiplies the factor, so a textured material keeps its average tint.
+//  * CUBICSPLINE animation samplers use each key's value and ignore the tangents (the
+//    curve is then interpolated linearly between keys).
+//  * When several animations drive the same property of a node, the first one wins.
+//  * Skinning and morph targets are not supported: a skinned mesh keeps its bind-pose
+//    geometry (placed where its joints put it in the rest pose) and a warning says so.
+//  * Every accessor and index is range-checked: a bad file throws Error, never reads
+//    outside its buffers.
+#include <tiny_gltf.h>
+
+#include <cstring>
+#include <functional>
+#include <map>
+#include <set>
+#include <sstream>
+#include "core/error.hpp"
+#include "core/mesh_loaders.hpp"
+
+namespace gilab {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Context {
+    const tinygltf::Model& model;
+    std::string file;
+    Scene& scene;
+    void warn(const std::string& message) {
+        const std::string w = file + ": " + message;
+        for (const auto& existing : scene.warnings)
+            if (existing == w) return;
+        scene.warnings.push_back(w);
+    }
+};
+
+// A validated window onto an accessor's bytes.
+struct AccessorView {
+    const unsigned char* data = nullptr;  // null: all zeros (accessor without buffer view)
+    size_t stride = 0;
+    size_t count = 0;
+    int components = 0;
+    int component_type = 0;
+    bool normalized = false;
+};
+
+std::string accessor_label(int index, const std::string& what) {
+    return what + " (accessor " + std::to_string(index) + ")";
+}
+
+AccessorView view_accessor(const Context& ctx, int index, const std::string& what) {
+    const auto& m = ctx.model;
+    if (index < 0 || size_t(index) >= m.accessors.size())
+        throw Error(ctx.file, what + ": accessor " + std::to_string(index) + " is out of range (the file has " +
+                                  std::to_string(m.accessors.size()) + " accessors)");
+    const tinygltf::Accessor& a = m.accessors[size_t(index)];
+    const std::string label = accessor_label(index, what);
+    if (a.sparse.isSparse) throw Error(ctx.file, label + ": sparse accessors are not supported");
+    AccessorView v;
+    v.components = tinygltf::GetNumComponentsInType(uint32_t(a.type));
+    const int csize = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType));
+    if (v.components <= 0 || csize <= 0 || a.componentType == TINYGLTF_COMPONENT_TYPE_DOUBLE)
+        throw Error(ctx.file, label + ": invalid accessor type or component type");
+    v.count = a.count;
+    v.component_type = a.componentType;
+    v.normalized = a.normalized;
+    if (a.bufferView < 0) return v;  // zeros, per the specification
+    if (size_t(a.bufferView) >= m.bufferViews.size())
+        throw Error(ctx.file, label + ": buffer view " + std::to_string(a.bufferView) + " is out of range");
+    const tinygltf::BufferView& bv = m.bufferViews[size_t(a.bufferView)];
+    if (bv.buffer < 0 || size_t(bv.buffer) >= m.buffers.size())
+        throw Error(ctx.file, label + ": buffer " + std::to_string(bv.buffer) + " is out of range");
+    const tinygltf::Buffer& buffer = m.buffers[size_t(bv.buffer)];
+    if (bv.byteOffset > buffer.data.size() || bv.byteLength > buffer.data.size() - bv.byteOffset)
+        throw Error(ctx.file, label + ": buffer view " + std::to_string(a.bufferView) +
+                                  " reaches past the end of its buffer (truncated file?)");
+    const size_t element = size_t(v.components) * size_t(csize);
+    v.stride = bv.byteStride ? bv.byteStride : element;
+    if (v.stride < element) throw Error(ctx.file, label + ": byte stride is smaller than one element");
+    if (v.count > 0) {
+        const size_t needed = a.byteOffset + v.stride * (v.count - 1) + element;
+        if (a.byteOffset > bv.byteLength || needed > bv.byteLength || (v.count - 1) > bv.byteLength / v.stride)
+            throw Error(ctx.file, label + ": " + std::to_string(v.count) + " elements reach past the end of buffer view " +
+                                      std::to_string(a.bufferView) + " (out of range or truncated)");
+    }
+    v.data = buffer.data.data() + bv.byteOffset + a.byteOffset;
+    return v;
+}
+
+float read_component(const unsigned char* p, int type, bool normalized) {
+    switch (type) {
+        case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+            float f;
+            std::memcpy(&f, p, 4);
+            return f;
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? float(*p) / 255.0f : float(*p);
+        case TINYGLTF_COMPONENT_TYPE_BYTE: {
+            float f = float(int8_t(*p));
+            return normalized ? std::max(f / 127.0f, -1.0f) : f;
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+            uint16_t s;
+            std::memcpy(&s, p, 2);
+            return normalized ? float(s) / 65535.0f : float(s);
+        }
+        case TINYGLTF_COMPONENT_TYPE_SHORT: {
+            int16_t s;
+            std::memcpy(&s, p, 2);
+            return normalized ? std::max(float(s) / 32767.0f, -1.0f) : float(s);
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+            uint32_t u;
+            std::memcpy(&u, p, 4);
+            return float(u);
+        }
+        default: return 0.0f;
+    }
+}
+
+// All elements of an accessor as floats, `components` per element.
+std::vector<float> read_floats(const Context& ctx, int index, int components, const std::string& what) {
+    AccessorView v = view_accessor(ctx, index, what);
+    if (v.components != components)
+        throw Error(ctx.file, accessor_label(index, what) + ": has " + std::to_string(v.components) +
+                                  " components per element, expected " + std::to_string(components));
+    std::vector<float> out(v.count * size_t(components), 0.0f);
+    if (!v.data) return out;
+    const int csize = tinygltf::GetComponentSizeInBytes(uint32_t(v.component_type));
+    for (size_t i = 0; i < v.count; ++i)
+        for (int c = 0; c < components; ++c)
+            out[i * size_t(components) + size_t(c)] =
+                read_component(v.data + i * v.stride + size_t(c * csize), v.component_type, v.normalized);
+    return out;
+}
+
+std::vector<uint32_t> read_indices(const Context& ctx, int index, const std::string& what) {
+    AccessorView v = view_accessor(ctx, index, what);
+    if (v.components != 1) throw Error(ctx.file, accessor_label(index, what) + ": indices must be scalars");
+    std::vector<uint32_t> out(v.count, 0);
+    if (!v.data) return out;
+    for (size_t i = 0; i < v.count; ++i) {
+        const unsigned char* p = v.data + i * v.stride;
+        switch (v.component_type) {
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: out[i] = *p; break;
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+                uint16_t s;
+                std::memcpy(&s, p, 2);
+                out[i] = s;
+                break;
+            }
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: std::memcpy(&out[i], p, 4); break;
+            default:
+                throw Error(ctx.file, accessor_label(index, what) +
+                                          ": indices must be unsigned byte, short or int");
+        }
+    }
+    return out;
+}
+
+Mat4 node_local_matrix(const tinygltf::Node& n) {
+    if (n.matrix.size() == 16) {
+        Mat4 m;
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) m[c][r] = float(n.matrix[size_t(c * 4 + r)]);
+        return m;
+    }
+    Transform t;
+    if (n.translation.size() == 3) t.translation = Vec3(n.translation[0], n.translation[1], n.translation[2]);
+    if (n.rotation.size() == 4)
+        t.rotation = glm::normalize(Quat(float(n.rotation[3]), float(n.rotation[0]), float(n.rotation[1]),
+                                         float(n.rotation[2])));
+    if (n.scale.size() == 3) t.scale = Vec3(n.scale[0], n.scale[1], n.scale[2]);
+    return t.matrix();
+}
+
+Transform node_local_transform(const tinygltf::Node& n) {
+    if (n.matrix.size() == 16) return Transform::from_matrix(node_local_matrix(n));
+    Transform t;
+    if (n.translation.size() == 3) t.translation = Vec3(n.translation[0], n.translation[1], n.translation[2]);
+    if (n.rotation.size() == 4)
+        t.rotation = glm::normalize(Quat(float(n.rotation[3]), float(n.rotation[0]), float(n.rotation[1]),
+                                         float(n.rotation[2])));
+    if (n.scale.size() == 3) t.scale = Vec3(n.scale[0], n.scale[1], n.scale[2]);
+    return t;
+}
+
+float srgb_to_linear(float c) {
+    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+// Mean linear colour of a decoded texture (sRGB-encoded colour textures); nullopt when
+// the image could not be decoded.
+std::optional<Vec3> mean_texture_color(const tinygltf::Model& m, int texture_index) {
+    if (texture_index < 0 || size_t(texture_index) >= m.textures.size()) return std::nullopt;
+    const int source = m.textures[size_t(texture_index)].source;
+    if (source < 0 || size_t(source) >= m.images.size()) return std::nullopt;
+    const tinygltf::Image& img = m.images[size_t(source)];
+    if (img.image.empty() || img.width <= 0 || img.height <= 0 || img.component <= 0) return std::nullopt;
+    const size_t bytes = img.bits == 16 ? 2 : 1;
+    const size_t pixels = size_t(img.width) * size_t(img.height);
+    if (img.image.size() < pixels * size_t(img.component) * bytes) return std::nullopt;
+    const size_t step = std::max<size_t>(1, pixels / 65536);
+    glm::dvec3 sum(0);
+    size_t n = 0;
+    for (size_t p = 0; p < pixels; p += step, ++n) {
+        Vec3 c;
+        for (int k = 0; k < 3; ++k) {
+            const int ch = img.component >= 3 ? k : 0;
+            const size_t at = (p * size_t(img.component) + size_t(ch)) * bytes;
+            float v;
+            if (bytes == 2) {
+                uint16_t s;
+                std::memcpy(&s, &img.image[at], 2);
+                v = float(s) / 65535.0f;
+            } else {
+                v = float(img.image[at]) / 255.0f;
+            }
+            c[k] = srgb_to_linear(v);
+        }
+        sum += glm::dvec3(c);
+    }
+    return Vec3(sum / double(n));
+}
+
+Material convert_material(Context& ctx, const tinygltf::Material& gm, size_t index) {
+    Material out;
+    out.name = gm.name.empty() ? "material" + std::to_string(index) : gm.name;
+    const auto& pbr = gm.pbrMetallicRoughness;
+    Vec3 base(1.0f);
+    if (pbr.baseColorFactor.size() >= 3) base = Vec3(pbr.baseColorFactor[0], pbr.baseColorFactor[1], pbr.baseColorFactor[2]);
+    if (pbr.baseColorTexture.index >= 0) {
+        if (auto mean = mean_texture_color(ctx.model, pbr.baseColorTexture.index))
+            base *= *mean;
+        else
+            ctx.warn("material '" + out.name + "': base colour texture could not be decoded; using the factor alone");
+    }
+    base = glm::clamp(base, Vec3(0.0f), Vec3(1.0f));
+    const float metallic = std::clamp(float(pbr.metallicFactor), 0.0f, 1.0f);
+    const float roughness = std::clamp(float(pbr.roughnessFactor), 0.0f, 1.0f);
+    out.albedo = base * (1.0f - metallic);
+    out.specular = glm::mix(Vec3(0.04f), base, metallic);
+    out.phong_exponent = exponent_from_roughness(roughness);
+    // Keep albedo + specular ≤ 1 so the material never reflects more than arrives.
+    float scale = 1.0f;
+    for (int c = 0; c < 3; ++c)
+        if (out.albedo[c] + out.specular[c] > 1.0f && out.specular[c] > 0.0f)
+            scale = std::min(scale, (1.0f - out.albedo[c]) / out.specular[c]);
+    out.specular *= std::max(scale, 0.0f);
+
+    Vec3 emission(0.0f);
+    if (gm.emissiveFactor.size() >= 3) emission = Vec3(gm.emissiveFactor[0], gm.emissiveFactor[1], gm.emissiveFactor[2]);
+    auto ext = gm.extensions.find("KHR_materials_emissive_strength");
+    if (ext != gm.extensions.end() && ext->second.Has("emissiveStrength") &&
+        ext->second.Get("emissiveStrength").IsNumber())
+        emission *= float(ext->second.Get("emissiveStrength").GetNumberAsDouble());
+    if (gm.emissiveTexture.index >= 0 && max_component(emission) > 0.0f) {
+        if (auto mean = mean_texture_color(ctx.model, gm.emissiveTexture.index)) emission *= *mean;
+    }
+    out.emission = glm::max(emission, Vec3(0.0f));
+    return out;
+}
+
+// One gilab Mesh per glTF mesh: all triangle primitives merged, material ids per primitive.
+struct MeshBuilder {
+    Context& ctx;
+    std::vector<uint32_t> material_map;  // glTF material → scene material
+    uint32_t default_material = UINT32_MAX;
+
+    uint32_t material_for(int gltf_material) {
+        if (gltf_material >= 0) {
+            if (size_t(gltf_material) >= material_map.size())
+                throw Error(ctx.file, "primitive uses material " + std::to_string(gltf_material) +
+                                          " but the file has " + std::to_string(material_map.size()) + " (out of range)");
+            return material_map[size_t(gltf_material)];
+        }
+        if (default_material == UINT32_MAX) {
+            default_material = uint32_t(ctx.scene.materials.size());
+            ctx.scene.materials.push_back(Material{});
+        }
+        return default_material;
+    }
+
+    Mesh build(size_t mesh_index) {
+        const tinygltf::Mesh& gm = ctx.model.meshes[mesh_index];
+        Mesh mesh;
+        mesh.name = gm.name.empty() ? "mesh" + std::to_string(mesh_index) : gm.name;
+        bool all_normals = true, all_uvs = true;
+        for (size_t p = 0; p < gm.primitives.size(); ++p) {
+            const tinygltf::Primitive& prim = gm.primitives[p];
+            const std::string where = "mesh '" + mesh.name + "' primitive " + std::to_string(p);
+            const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+            if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+                mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+                ctx.warn(where + ": points/lines primitive skipped");
+                continue;
+            }
+            if (!prim.targets.empty()) ctx.warn(where + ": morph targets are not supported; the base shape is used");
+            auto pos_it = prim.attributes.find("POSITION");
+            if (pos_it == prim.attributes.end()) throw Error(ctx.file, where + ": no POSITION attribute");
+            const std::vector<float> pos = read_floats(ctx, pos_it->second, 3, where + " POSITION");
+            const size_t count = pos.size() / 3;
+            const uint32_t base = uint32_t(mesh.positions.size());
+            for (size_t i = 0; i < count; ++i) mesh.positions.emplace_back(pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]);
+
+            auto nrm_it = prim.attributes.find("NORMAL");
+            if (nrm_it != prim.attributes.end() && all_normals) {
+                const std::vector<float> nrm = read_floats(ctx, nrm_it->second, 3, where + " NORMAL");
+                if (nrm.size() != pos.size())
+                    throw Error(ctx.file, where + ": NORMAL count differs from POSITION count");
+                for (size_t i = 0; i < count; ++i) mesh.normals.emplace_back(nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]);
+            } else {
+                all_normals = false;
+            }
+            auto uv_it = prim.attributes.find("TEXCOORD_0");
+            if (uv_it != prim.attributes.end() && all_uvs) {
+                const std::vector<float> uv = read_floats(ctx, uv_it->second, 2, where + " TEXCOORD_0");
+                if (uv.size() / 2 != count)
+                    throw Error(ctx.file, where + ": TEXCOORD_0 count differs from POSITION count");
+                for (size_t i = 0; i < count; ++i) mesh.uvs.emplace_back(uv[2 * i], uv[2 * i + 1]);
+            } else {
+                all_uvs = false;
+            }
+
+            std::vector<uint32_t> idx;
+            if (prim.indices >= 0) {
+                idx = read_indices(ctx, prim.indices, where + " indices");
+                for (size_t i = 0; i < idx.size(); ++i)
+                    if (idx[i] >= count)
+                        throw Error(ctx.file, where + ": index " + std::to_string(i) + " is " + std::to_string(idx[i]) +
+                                                  " but the primitive has " + std::to_string(count) +
+                                                  " vertices (index out of range)");
+            } else {
+                idx.resize(count);
+                for (size_t i = 0; i < count; ++i) idx[i] = uint32_t(i);
+            }
+            const uint32_t material = material_for(prim.material);
+            auto add = [&](uint32_t a, uint32_t b, uint32_t c) {
+                mesh.triangles.emplace_back(base + a, base + b, base + c);
+                mesh.material_ids.push_back(material);
+            };
+            if (mode == TINYGLTF_MODE_TRIANGLES) {
+                if (idx.size() % 3 != 0)
+                    throw Error(ctx.file, where + ": " + std::to_string(idx.size()) +
+                                              " indices is not a multiple of 3 for a triangle list");
+                for (size_t i = 0; i + 2 < idx.size(); i += 3) add(idx[i], idx[i + 1], idx[i + 2]);
+            } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+                for (size_t i = 0; i + 2 < idx.size(); ++i)
+                    if (i % 2 == 0) add(idx[i], idx[i + 1], idx[i + 2]);
+                    else add(idx[i], idx[i + 2], idx[i + 1]);
+            } else {
+                for (size_t i = 1; i + 1 < idx.size(); ++i) add(idx[i], idx[i + 1], idx[0]);
+            }
+        }
+        if (!all_normals) mesh.normals.clear();
+        if (!all_uvs) mesh.uvs.clear();
+        for (const Vec3& n : mesh.normals)
+            if (!(glm::dot(n, n) > 0.0f) || !is_finite(n)) {
+                ctx.warn("mesh '" + mesh.name + "': invalid vertex normals; using flat shading");
+                mesh.normals.clear();
+                break;
+            }
+        for (Vec3& n : mesh.normals) n = glm::normalize(n);
+        return mesh;
+    }
+};
+
+template <typename T>
+void expand_step(KeyframeChannel<T>& c) {
+    // STEP as linear keys: hold each value until just before the next key.
+    KeyframeChannel<T> out;
+    for (size_t i = 0; i < c.times.size(); ++i) {
+        if (i > 0) {
+            const float hold = std::nextafter(c.times[i], -kInfinity);
+            if (hold > out.times.back()) {
+                out.times.push_back(hold);
+                out.values.push_back(c.values[i - 1]);
+            }
+        }
+        out.times.push_back(c.times[i]);
+        out.values.push_back(c.values[i]);
+    }
+    c = std::move(out);
+}
+
+struct NodeChannels {
+    bool has[3] = {false, false, false};
+    bool step[3] = {false, false, false};
+    TrsAnimation anim;
+};
+
+void load_animations(Context& ctx, const std::vector<int>& gltf_to_node) {
+    const auto& m = ctx.model;
+    std::map<int, NodeChannels> per_node;
+    size_t ignored_overlaps = 0, ignored_weights = 0;
+    for (size_t ai = 0; ai < m.animations.size(); ++ai) {
+        const tinygltf::Animation& anim = m.animations[ai];
+        const std::string aname = "animation " + std::to_string(ai) + (anim.name.empty() ? "" : " '" + anim.name + "'");
+        for (size_t ci = 0; ci < anim.channels.size(); ++ci) {
+            const tinygltf::AnimationChannel& ch = anim.channels[ci];
+            const std::string where = aname + " channel " + std::to_string(ci);
+            if (ch.target_node < 0 || size_t(ch.target_node) >= m.nodes.size())
+                throw Error(ctx.file, where + ": target node " + std::to_string(ch.target_node) + " is out of range");
+            if (ch.sampler < 0 || size_t(ch.sampler) >= anim.samplers.size())
+                throw Error(ctx.file, where + ": sampler " + std::to_string(ch.sampler) + " is out of range");
+            int path;
+            if (ch.target_path == "translation") path = 0;
+            else if (ch.target_path == "rotation") path = 1;
+            else if (ch.target_path == "scale") path = 2;
+            else {
+                ++ignored_weights;
+                continue;
+            }
+            const int node = gltf_to_node[size_t(ch.target_node)];
+            if (node < 0) continue;  // node not in the displayed scene
+            NodeChannels& nc = per_node[node];
+            if (nc.has[path]) {
+                ++ignored_overlaps;
+                continue;
+            }
+            const tinygltf::AnimationSampler& s = anim.samplers[size_t(ch.sampler)];
+            const bool cubic = s.interpolation == "CUBICSPLINE";
+            const bool step = s.interpolation == "STEP";
+            if (!cubic && !step && s.interpolation != "LINEAR")
+                throw Error(ctx.file, where + ": unknown interpolation '" + s.interpolation + "'");
+            std::vector<float> times = read_floats(ctx, s.input, 1, where + " input");
+            const int comps = path == 1 ? 4 : 3;
+            std::vector<float> values = read_floats(ctx, s.output, comps, where + " output");
+            const size_t per_key = cubic ? 3 : 1;
+            if (values.size() != times.size() * per_key * size_t(comps))
+                throw Error(ctx.file, where + ": " + std::to_string(times.size()) + " key times but " +
+                                          std::to_string(values.size() / size_t(comps)) + " output values");
+            if (times.empty()) continue;
+            // Keys must not go back in time; a repeated time keeps the later key.
+            std::vector<size_t> keep;
+            for (size_t k = 0; k < times.size(); ++k) {
+                if (!std::isfinite(times[k])) throw Error(ctx.file, where + ": non-finite key time");
+                if (k > 0 && times[k] < times[k - 1])
+                    throw Error(ctx.file, where + ": key times decrease at key " + std::to_string(k));
+                if (k + 1 < times.size() && times[k + 1] == times[k]) continue;
+                keep.push_back(k);
+            }
+            auto value_at = [&](size_t k, int c) { return values[(k * per_key + (cubic ? 1 : 0)) * size_t(comps) + size_t(c)]; };
+            for (size_t k : keep) {
+                if (path == 1) {
+                    Quat q(value_at(k, 3), value_at(k, 0), value_at(k, 1), value_at(k, 2));
+                    float len = glm::length(q);
+                    if (!(len > 0.0f) || !std::isfinite(len)) throw Error(ctx.file, where + ": invalid rotation key");
+                    nc.anim.rotation.times.push_back(times[k]);
+                    nc.anim.rotation.values.push_back(q / len);
+                } else {
+                    Vec3 v(value_at(k, 0), value_at(k, 1), value_at(k, 2));
+                    if (!is_finite(v)) throw Error(ctx.file, where + ": non-finite key value");
+                    auto& channel = path == 0 ? nc.anim.translation : nc.anim.scale;
+                    channel.times.push_back(times[k]);
+                    channel.values.push_back(v);
+                }
+            }
+            nc.has[path] = true;
+            nc.step[path] = step;
+        }
+    }
+    for (auto& [node, nc] : per_node) {
+        bool any_step = false, all_step = true;
+        for (int p = 0; p < 3; ++p)
+            if (nc.has[p]) {
+                any_step |= nc.step[p];
+                all_step &= nc.step[p];
+            }
+        if (all_step) {
+            nc.anim.step = true;
+        } else if (any_step) {  // mixed: express the STEP channels as linear ones
+            if (nc.has[0] && nc.step[0]) expand_step(nc.anim.translation);
+            if (nc.has[1] && nc.step[1]) expand_step(nc.anim.rotation);
+            if (nc.has[2] && nc.step[2]) expand_step(nc.anim.scale);
+        }
+        ctx.scene.nodes[size_t(node)].animation = std::move(nc.anim);
+    }
+    if (ignored_overlaps)
+        ctx.warn(std::to_string(ignored_overlaps) +
+                 " animation channels ignored: an earlier animation already drives the same node property");
+    if (ignored_weights) ctx.warn("morph-target weight animations are not supported and were ignored");
+}
+
+bool load_image_tolerant(tinygltf::Image* image, const int index, std::string* err, std::string* warn, int w, int h,
+                         const unsigned char* bytes, int size, void* user) {
+    std::string decode_error;
+    if (tinygltf::LoadImageData(image, index, &decode_error, warn, w, h, bytes, size, user)) return true;
+    // Textures only tint materials here; an undecodable image is not fatal.
+    if (warn) *warn += "image " + std::to_string(index) + " could not be decoded and is ignored\n";
+    return true;
+}
+
+void add_lines(Context& ctx, const std::string& text) {
+    std::istringstream s(text);
+    std::string line;
+    while (std::getline(s, line))
+        if (!line.empty()) ctx.warn(line);
+}
+
+}  // namespace
+
+Scene load_gltf(const fs::path& path) {
+    const std::string file = path.string();
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) throw Error(file, "file not found");
+    std::string ext = path.extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+
+    tinygltf::Model model;
+    tinygltf::TinyGLTF reader;
+    reader.SetImageLoader(load_image_tolerant, nullptr);
+    std::string err, warn;
+    const bool ok = ext == ".glb" ? reader.LoadBinaryFromFile(&model, &err, &warn, file)
+                                  : reader.LoadASCIIFromFile(&model, &err, &warn, file);
+    while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
+    if (!ok) throw Error(file, "malformed glTF: " + (err.empty() ? std::string("could not be parsed") : err));
+
+    Scene scene;
+    scene.name = path.stem().string();
+    scene.source = file;
+    Context ctx{model, file, scene};
+    add_lines(ctx, warn);
+    if (!err.empty()) add_lines(ctx, err);
+
+    for (size_t i = 0; i < model.materials.size(); ++i) scene.materials.push_back(convert_material(ctx, model.materials[i], i));
+    MeshBuilder builder{ctx, {}, UINT32_MAX};
+    builder.material_map.resize(model.materials.size());
+    for (size_t i = 0; i < model.materials.size(); ++i) builder.material_map[i] = uint32_t(i);
+
+    // Which nodes to show: the default scene, else the first, else every root node.
+    std::vector<int> roots;
+    if (!model.scenes.empty()) {
+        int si = model.defaultScene >= 0 ? model.defaultScene : 0;
+        if (size_t(si) >= model.scenes.size()) throw Error(file, "default scene " + std::to_string(si) + " is out of range");
+        roots = model.scenes[size_t(si)].nodes;
+    } else {
+        std::vector<bool> is_child(model.nodes.size(), false);
+        for (const auto& n : model.nodes)
+            for (int c : n.children)
+                if (c >= 0 && size_t(c) < model.nodes.size()) is_child[size_t(c)] = true;
+        for (size_t i = 0; i < model.nodes.size(); ++i)
+            if (!is_child[i]) roots.push_back(int(i));
+    }
+
+    // Depth-first, so parents precede children; rest-pose world matrices on the way.
+    std::vector<int> gltf_to_node(model.nodes.size(), -1);
+    std::vector<Mat4> gltf_world(model.nodes.size(), Mat4(1.0f));
+    std::vector<bool> gltf_has_world(model.nodes.size(), false);
+    std::function<void(int, int, const Mat4&)> visit = [&](int gi, int parent, const Mat4& parent_world) {
+        if (gi < 0 || size_t(gi) >= model.nodes.size())
+            throw Error(file, "node " + std::to_string(gi) + " is out of range (the file has " +
+                                  std::to_string(model.nodes.size()) + " nodes)");
+        if (gltf_to_node[size_t(gi)] >= 0)
+            throw Error(file, "node " + std::to_string(gi) + " has more than one parent (or a cycle)");
+        const tinygltf::Node& gn = model.nodes[size_t(gi)];
+        SceneNode node;
+        node.name = gn.name.empty() ? "node" + std::to_string(gi) : gn.name;
+        node.parent = parent;
+        node.local = node_local_transform(gn);
+        const int index = int(scene.nodes.size());
+        gltf_to_node[size_t(gi)] = index;
+        gltf_world[size_t(gi)] = parent_world * node_local_matrix(gn);
+        gltf_has_world[size_t(gi)] = true;
+        scene.nodes.push_back(std::move(node));
+        for (int child : gn.children) visit(child, index, gltf_world[size_t(gi)]);
+    };
+    for (int r : roots) visit(r, -1, Mat4(1.0f));
+
+    // Meshes (built once, shared by every node that instances them), lights, camera.
+    std::vector<int> mesh_slot(model.meshes.size(), -1);
+    for (size_t gi = 0; gi < model.nodes.size(); ++gi) {
+        const int ni = gltf_to_node[gi];
+        if (ni < 0) continue;
+        const tinygltf::Node& gn = model.nodes[gi];
+        if (gn.mesh >= 0) {
+            if (size_t(gn.mesh) >= model.meshes.size())
+                throw Error(file, "node " + std::to_string(gi) + " references mesh " + std::to_string(gn.mesh) +
+                                      " but the file has " + std::to_string(model.meshes.size()) + " (out of range)");
+            if (gn.skin >= 0) {
+                if (size_t(gn.skin) >= model.skins.size())
+                    throw Error(file, "node " + std::to_string(gi) + " references skin " + std::to_string(gn.skin) +
+                                          " which is out of range");
+                // Bind pose: the skin's first joint in its rest pose times its inverse
+                // bind matrix places the geometry; the node's own transform is ignored.
+                const tinygltf::Skin& skin = model.skins[size_t(gn.skin)];
+                Mat4 place(1.0f);
+                if (!skin.joints.empty()) {
+                    const int j = skin.joints[0];
+                    if (j < 0 || size_t(j) >= model.nodes.size())
+                        throw Error(file, "skin " + std::to_string(gn.skin) + " joint " + std::to_string(j) +
+                                              " is out of range");
+                    Mat4 ibm(1.0f);
+                    if (skin.inverseBindMatrices >= 0) {
+                        std::vector<float> m16 = read_floats(ctx, skin.inverseBindMatrices, 16,
+                                                             "skin " + std::to_string(gn.skin) + " inverse bind matrices");
+                        if (m16.size() >= 16)
+                            for (int c = 0; c < 4; ++c)
+                                for (int r = 0; r < 4; ++r) ibm[c][r] = m16[size_t(c * 4 + r)];
+                    }
+                    place = (gltf_has_world[size_t(j)] ? gltf_world[size_t(j)] : Mat4(1.0f)) * ibm;
+                }
+                Mesh mesh = builder.build(size_t(gn.mesh));
+                const Mat3 nm = glm::transpose(glm::inverse(Mat3(place)));
+                for (Vec3& p : mesh.positions) p = Vec3(place * Vec4(p, 1.0f));
+                for (Vec3& n : mesh.normals) {
+                    n = nm * n;
+                    float len = glm::length(n);
+                    n = len > 0 ? n / len : Vec3(0, 0, 1);
+                }
+                if (glm::determinant(Mat3(place)) < 0)
+                    for (UVec3& t : mesh.triangles) std::swap(t.y, t.z);
+                ctx.warn("mesh '" + mesh.name + "' is skinned; skinning is not supported, the bind-pose geometry is used");
+                if (mesh.triangles.empty()) continue;
+                scene.degenerate_triangles_dropped +=
+                    validate_and_clean(mesh, scene.materials.size(), file).degenerate_triangles_dropped;
+                SceneNode holder;
+                holder.name = scene.nodes[size_t(ni)].name + " (bind pose)";
+                scene.meshes.push_back(std::move(mesh));
+                holder.meshes.push_back(uint32_t(scene.meshes.size() - 1));
+                scene.nodes.push_back(std::move(holder));
+            } else {
+                if (mesh_slot[size_t(gn.mesh)] < 0) {
+                    Mesh mesh = builder.build(size_t(gn.mesh));
+                    if (!mesh.triangles.empty()) {
+                        scene.degenerate_triangles_dropped +=
+                            validate_and_clean(mesh, scene.materials.size(), file).degenerate_triangles_dropped;
+                        scene.meshes.push_back(std::move(mesh));
+                        mesh_slot[size_t(gn.mesh)] = int(scene.meshes.size() - 1);
+                    } else {
+                        mesh_slot[size_t(gn.mesh)] = INT32_MAX;  // nothing to draw
+                    }
+                }
+                if (mesh_slot[size_t(gn.mesh)] != INT32_MAX)
+                    scene.nodes[size_t(ni)].meshes.push_back(uint32_t(mesh_slot[size_t(gn.mesh)]));
+            }
+        }
+        auto light_ext = gn.extensions.find("KHR_lights_punctual");
+        if (light_ext != gn.extensions.end() && light_ext->second.Has("light")) {
+            const tinygltf::Value& v = light_ext->second.Get("light");
+            const int li = v.IsNumber() ? v.GetNumberAsInt() : -1;
+            if (li < 0 || size_t(li) >= model.lights.size())
+                throw Error(file, "node " + std::to_string(gi) + " references light " + std::to_string(li) +
+                                      " but the file has " + std::to_string(model.lights.size()) + " (out of range)");
+            const tinygltf::Light& gl = model.lights[size_t(li)];
+            PunctualLight light;
+            light.name = gl.name.empty() ? "light" + std::to_string(li) : gl.name;
+            Vec3 color(1.0f);
+            if (gl.color.size() >= 3) color = Vec3(gl.color[0], gl.color[1], gl.color[2]);
+            light.intensity = color * float(gl.intensity);
+            light.position = Vec3(0.0f);
+            light.direction = Vec3(0, 0, -1);  // glTF lights shine down their node's -Z
+            light.node = ni;
+            if (gl.type == "point") {
+                light.type = LightType::Point;
+            } else if (gl.type == "spot") {
+                light.type = LightType::Spot;
+                light.cos_inner = std::cos(float(gl.spot.innerConeAngle));
+                light.cos_outer = std::cos(float(gl.spot.outerConeAngle));
+                if (light.cos_outer > light.cos_inner)
+                    throw Error(file, "light '" + light.name + "': outer cone angle is smaller than the inner one");
+            } else if (gl.type == "directional") {
+                light.type = LightType::Directional;
+            } else {
+                throw Error(file, "light '" + light.name + "' has unknown type '" + gl.type + "'");
+            }
+            scene.lights.push_back(light);
+        }
+        if (gn.camera >= 0 && !scene.camera && size_t(gn.camera) < model.cameras.size() &&
+            model.cameras[size_t(gn.camera)].type == "perspective") {
+            const Mat4& w = gltf_world[gi];
+            SceneCamera cam;
+            cam.position = Vec3(w * Vec4(0, 0, 0, 1));
+            cam.target = cam.position + glm::normalize(Vec3(w * Vec4(0, 0, -1, 0)));
+            cam.up = glm::normalize(Vec3(w * Vec4(0, 1, 0, 0)));
+            cam.vertical_fov_degrees = glm::degrees(float(model.cameras[size_t(gn.camera)].perspective.yfov));
+            scene.camera = cam;
+        }
+    }
+    load_animations(ctx, gltf_to_node);
+    if (scene.meshes.empty()) throw Error(file, "no triangle meshes in the displayed scene");
+    return scene;
+}
+
+}  // namespace gilab
