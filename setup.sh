@@ -35,6 +35,7 @@ case "$mode" in
   run)
     ./build/gilab render cornell --hmd vive --spp 16 --output results/render/cornell_stereo
     ./build/gilab experiment all --quick
+    ./build/gilab report
     echo "setup: results are in $(pwd)/results"
     ;;
   test)

@@ -1,10 +1,11 @@
-// The gilab command line: render, info, list, experiment.
+// The gilab command line: render, info, list, experiment, report.
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include "core/error.hpp"
 #include "core/hmd.hpp"
 #include "core/parallel.hpp"
 #include "experiments/experiment.hpp"
+#include "experiments/html_report.hpp"
 #include "experiments/render_command.hpp"
 #include "scenes/builtin_scenes.hpp"
 #include "scenes/scene_library.hpp"
@@ -118,6 +119,10 @@ int main(int argc, char** argv) {
     experiment->add_option("--results", results_dir, "results root directory")->capture_default_str();
     experiment->add_option("--seed", seed, "random seed")->capture_default_str();
 
+    std::string report_dir = "results";
+    auto* report = app.add_subcommand("report", "gather every results/NAME/results.json into results/report.html");
+    report->add_option("--results", report_dir, "results root directory")->capture_default_str();
+
     CLI11_PARSE(app, argc, argv);
 
     try {
@@ -131,6 +136,10 @@ int main(int argc, char** argv) {
             std::cout << describe_scene(info_scene, assets);
         } else if (*list) {
             print_list(list_what);
+        } else if (*report) {
+            int n = write_html_report(report_dir);
+            std::cout << "wrote " << (std::filesystem::path(report_dir) / "report.html").string() << " (" << n
+                      << " experiments)\n";
         } else if (*experiment) {
             if (experiment_names.size() == 1 && experiment_names[0] == "list") {
                 print_list("experiments");

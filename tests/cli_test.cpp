@@ -116,4 +116,19 @@ TEST(Cli, QuickCoreRaysWritesItsTables) {
     const auto& rows = doc["tables"][0]["rows"];
     ASSERT_GE(rows.size(), 2u);  // at least the Cornell box's primary and shadow rows
     for (const auto& row : rows) EXPECT_GT(row["single_mrays_per_s"].get<double>(), 0.0);
+
+    Result report = run("report --results " + dir.string());
+    ASSERT_EQ(report.exit_code, 0) << report.output;
+    std::ifstream html(dir / "report.html");
+    std::string text((std::istreambuf_iterator<char>(html)), std::istreambuf_iterator<char>());
+    EXPECT_TRUE(contains(text, "core-rays"));
+    EXPECT_TRUE(contains(text, "single_mrays_per_s"));
+}
+
+TEST(Cli, ReportWithoutResultsIsAnError) {
+    fs::path dir = gilab::test::temp_dir("cli_report_empty");
+    Result r = run("report --results " + dir.string());
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_TRUE(contains(r.output, "no results")) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "report.html"));
 }

@@ -94,7 +94,9 @@ TEST(Bsdf, BelowTheShadingHemisphereIsBlack) {
         EXPECT_EQ(bsdf_pdf(m, kNormal, down, up), 0.0f);
         EXPECT_FALSE(bsdf_sample(m, kNormal, down, rng).valid);
         BsdfSample s = bsdf_sample(m, kNormal, up, rng);
-        if (s.valid) EXPECT_GT(glm::dot(s.wi, kNormal), 0.0f);
+        if (s.valid) {
+            EXPECT_GT(glm::dot(s.wi, kNormal), 0.0f);
+        }
     }
 }
 

@@ -175,8 +175,12 @@ TEST(LightSampler, SpotFalloffIsSmoothBetweenTheCones) {
         Vec3 x = spot.position + Vec3(std::sin(angle), -std::cos(angle), 0);  // distance 1
         LightSample s = lights.sample_incident(x, rng);
         float value = s.Li.x;
-        if (angle <= 0.3f - 1e-3f) EXPECT_NEAR(value, 2.0f, 1e-4f);
-        if (angle >= 0.6f + 1e-3f) EXPECT_EQ(value, 0.0f);
+        if (angle <= 0.3f - 1e-3f) {
+            EXPECT_NEAR(value, 2.0f, 1e-4f);
+        }
+        if (angle >= 0.6f + 1e-3f) {
+            EXPECT_EQ(value, 0.0f);
+        }
         if (angle > 0.3f + 1e-3f && angle < 0.6f - 1e-3f) {
             EXPECT_GT(value, 0.0f);
             EXPECT_LT(value, 2.0f);
