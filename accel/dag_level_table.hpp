@@ -19,26 +19,31 @@ public:
     uint32_t find_or_insert(uint32_t header, const uint32_t* children, uint32_t count) {
         return find_or_insert(header, children, count, hash(header, children, count));
     }
-
-    size_t size() const { return headers_.size(); }
-    uint32_t header(uint32_t id) const { return headers_[id]; }
-    std::span<const uint32_t> children(uint32_t id) const {
-        return {children_.data() + child_begin_[id], children_.data() + child_begin_[id + 1]};
+    // Starts loading the slot a later lookup of this hash will probe first.
+    void prefetch(uint64_t hash) const {
+        if (!slots_.empty()) __builtin_prefetch(&slots_[hash & mask_]);
     }
-    size_t child_count_total() const { return children_.size(); }
+
+    size_t size() const { return offsets_.size(); }
+    uint32_t header(uint32_t id) const { return records_[offsets_[id] + 1]; }
+    std::span<const uint32_t> children(uint32_t id) const {
+        const uint32_t* r = records_.data() + offsets_[id];
+        return {r + 3, r[2]};
+    }
+    size_t child_count_total() const { return child_total_; }
     size_t memory_bytes() const;
-    void reserve(size_t nodes);
 
 private:
     void grow();
 
-    std::vector<uint32_t> headers_;
-    std::vector<uint64_t> child_begin_{0};
-    std::vector<uint32_t> children_;
-    // Open addressing with linear probing: slot holds id + 1 (0 = empty) and the hash.
-    std::vector<uint32_t> slot_ids_;
-    std::vector<uint32_t> slot_tags_;
+    // Records back to back: id, header, child count, child ids.
+    std::vector<uint32_t> records_;
+    std::vector<uint32_t> offsets_;  // record of each id
+    // Open addressing with linear probing; a slot is (upper hash bits << 32) | (record
+    // offset + 1), 0 = empty, so one probe touches one word and a hit one record.
+    std::vector<uint64_t> slots_;
     uint64_t mask_ = 0;
+    size_t child_total_ = 0;
 };
 
 }  // namespace gilab

@@ -1,5 +1,5 @@
 #include "accel/esvo.hpp"
-#include <bit>
+#include "accel/child_mask.hpp"
 #include "core/error.hpp"
 #include "core/morton.hpp"
 
@@ -29,7 +29,7 @@ Esvo Esvo::from_svo(const Svo& svo) {
     // interior level's children are all leaf voxels.
     const uint64_t with_block = svo.level_offset(depth - 1);
     auto fc = [&](uint64_t x) { return uint64_t(svo.first_child(uint32_t(x))); };
-    auto kids = [&](uint64_t x) { return uint32_t(std::popcount(svo.mask(uint32_t(x)))); };
+    auto kids = [&](uint64_t x) { return child_count(svo.mask(uint32_t(x))); };
 
     // Bottom-up: words below each node (its child block, the block's far pointers and
     // the children's subtrees) and how many far pointers its child block needs.
@@ -123,7 +123,7 @@ uint32_t Esvo::child(uint32_t d, int slot) const {
     if (!(valid & bit)) return kInvalidNode;
     if (leaf & bit) return kLeafChild;
     uint32_t nonleaf = valid & ~leaf;
-    return child_block(d) + 2u * uint32_t(std::popcount(nonleaf & (bit - 1)));
+    return child_block(d) + 2u * child_rank(nonleaf, slot);
 }
 
 bool Esvo::contains_voxel(const UVec3& v) const {

@@ -1,7 +1,7 @@
 #include "accel/svdag.hpp"
+#include "accel/child_mask.hpp"
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include "accel/dag_level_table.hpp"
@@ -30,7 +30,7 @@ public:
             uint32_t leaf = leaf_id();
             std::array<uint32_t, 8> kids;
             kids.fill(leaf);
-            id = tables_[depth_ - 1].find_or_insert(mask, kids.data(), uint32_t(std::popcount(mask)));
+            id = tables_[depth_ - 1].find_or_insert(mask, kids.data(), child_count(mask));
         }
         return id;
     }
@@ -208,17 +208,18 @@ Svdag Svdag::from_svo(const Svo& svo) {
                         uint32_t node = uint32_t(begin + j);
                         uint8_t m = svo.mask(node);
                         hashes[j] = DagLevelTable::hash(m, ids_below.data() + (svo.first_child(node) - child_base),
-                                                        uint32_t(std::popcount(m)));
+                                                        child_count(m));
                     }
                 });
                 DagLevelTable& table = as.table(l);
-                table.reserve(std::min<uint64_t>(n, 1u << 20));
                 ids.resize(n);
+                constexpr uint64_t kAhead = 16;  // prefetch distance: lookups miss the cache
                 for (uint64_t j = 0; j < n; ++j) {
+                    if (j + kAhead < n) table.prefetch(hashes[j + kAhead]);
                     uint32_t node = uint32_t(begin + j);
                     uint8_t m = svo.mask(node);
                     ids[j] = table.find_or_insert(m, ids_below.data() + (svo.first_child(node) - child_base),
-                                                  uint32_t(std::popcount(m)), hashes[j]);
+                                                  child_count(m), hashes[j]);
                 }
                 dedup_ms += t.elapsed_ms();
                 std::swap(ids, ids_below);
@@ -328,13 +329,13 @@ Svdag Svdag::from_voxelizer(const Voxelizer& voxelizer, int split_level) {
 uint32_t Svdag::child(uint32_t node, int slot) const {
     uint32_t m = words_[node] & 0xffu;
     if (!(m & (1u << slot))) return kInvalidNode;
-    return words_[node + 1 + std::popcount(m & ((1u << slot) - 1))];
+    return words_[node + 1 + child_rank(m, slot)];
 }
 
 std::vector<uint32_t> Svdag::level_nodes(int level) const {
     std::vector<uint32_t> nodes;
     if (empty() || level < 0 || level > depth_) return nodes;
-    for (uint64_t a = level_begin_[level]; a < level_begin_[level + 1]; a += 1 + std::popcount(words_[a] & 0xffu))
+    for (uint64_t a = level_begin_[level]; a < level_begin_[level + 1]; a += 1 + child_count(words_[a]))
         nodes.push_back(uint32_t(a));
     return nodes;
 }
@@ -352,7 +353,7 @@ uint64_t Svdag::voxel_count() const {
     for (uint32_t a : level_nodes(depth_)) below[a] = 1;
     for (int l = depth_ - 1; l >= 0; --l)
         for (uint32_t a : level_nodes(l)) {
-            int k = std::popcount(words_[a] & 0xffu);
+            int k = int(child_count(words_[a]));
             uint64_t sum = 0;
             for (int i = 0; i < k; ++i) sum += below[words_[a + 1 + i]];
             below[a] = sum;

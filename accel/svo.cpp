@@ -1,5 +1,5 @@
 #include "accel/svo.hpp"
-#include <bit>
+#include "accel/child_mask.hpp"
 #include "core/error.hpp"
 #include "core/morton.hpp"
 
@@ -67,7 +67,7 @@ Svo Svo::build(const VoxelGrid& grid, std::span<const uint64_t> codes) {
     uint64_t next = svo.level_counts_.empty() ? 0 : svo.level_offsets_[1];
     for (uint64_t i = 0; i < interior; ++i) {
         svo.first_child_[i] = static_cast<uint32_t>(next);
-        next += std::popcount(svo.masks_[i]);
+        next += child_count(svo.masks_[i]);
     }
     svo.build_ms_ = clock.elapsed_ms();
     return svo;
@@ -81,7 +81,7 @@ uint32_t Svo::child(uint32_t node, int slot) const {
     if (node >= first_child_.size()) return kInvalidNode;
     uint8_t m = masks_[node];
     if (!(m & (1u << slot))) return kInvalidNode;
-    return first_child_[node] + std::popcount(uint32_t(m & ((1u << slot) - 1)));
+    return first_child_[node] + child_rank(m, slot);
 }
 
 bool Svo::contains_voxel(const UVec3& v) const {

@@ -119,7 +119,8 @@ std::optional<Vec2> EyeCamera::project(const Vec3& world_point) const {
     glm::dvec3 local = glm::conjugate(glm::dquat(orientation_)) *
                        (glm::dvec3(world_point) - glm::dvec3(position_));
     double depth = -local.z;
-    if (!(depth > 0.0) || !std::isfinite(depth)) return std::nullopt;
+    // Points (numerically) in the eye plane would map to tangents beyond 1e7: no pixel.
+    if (!(depth > 1e-7 * glm::length(local)) || !std::isfinite(depth)) return std::nullopt;
     double x = local.x / depth, y = local.y / depth;
     double px = (x - fov_.left) / (double(fov_.right) - fov_.left) * width_;
     double py = (double(fov_.top) - y) / (double(fov_.top) - fov_.bottom) * height_;

@@ -31,7 +31,7 @@ std::vector<HmdPreset> make_presets() {
         "here). Frustum: IVRSystem::GetProjectionRaw as reported by SteamVR on an HTC Vive, "
         "left (-1.3975, 1.25023, -1.47588, 1.46464), right (-1.25107, 1.40556, -1.48467, "
         "1.46426), https://github.com/ValveSoftware/openvr/issues/256; an independent hmdq "
-        "record agrees to 0.3% (https://risa2000.github.io/hmdgdb/hmd_cfgs/"
+        "record of another unit agrees within 1% (https://risa2000.github.io/hmdgdb/hmd_cfgs/"
         "Vive_Native_R90.html). Units differ slightly by factory calibration. IPD: 63 mm "
         "default.";
     presets.push_back(vive);

@@ -39,8 +39,13 @@ public:
     explicit TempFile(const fs::path& target) : target_(target) {
         if (!target.has_filename()) throw Error(target.string(), "not a file path");
         static std::atomic<uint64_t> counter{0};
-        std::string name = "." + target.filename().string() + ".tmp." +
-                           std::to_string(::getpid()) + "." + std::to_string(counter++);
+        // Appended piecewise: GCC 12 warns falsely (-Wrestrict) on "." + std::string.
+        std::string name(1, '.');
+        name += target.filename().string();
+        name += ".tmp.";
+        name += std::to_string(::getpid());
+        name += '.';
+        name += std::to_string(counter++);
         path_ = target.parent_path() / name;
     }
     ~TempFile() {

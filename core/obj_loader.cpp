@@ -174,39 +174,42 @@ Scene load_obj(const fs::path& path) {
     // Index checks first, with the OBJ line of the offending face.
     size_t face_ordinal = 0;
     bool all_normals = nn > 0, all_uvs = nt > 0;
+    size_t bad_normal_line = 0, bad_uv_line = 0;
     for (const auto& shape : shapes) {
         size_t offset = 0;
         for (size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f, ++face_ordinal) {
             const size_t corners = shape.mesh.num_face_vertices[f];
             if (offset + corners > shape.mesh.indices.size())
                 throw Error(file, "inconsistent face data (parser error)");
-            auto where = [&]() {
-                return face_ordinal < scan.face_lines.size()
-                           ? file + ":" + std::to_string(scan.face_lines[face_ordinal])
-                           : file;
+            auto where_line = [&]() -> size_t {
+                return face_ordinal < scan.face_lines.size() ? scan.face_lines[face_ordinal] : 0;
             };
+            auto where = [&]() { return where_line() ? file + ":" + std::to_string(where_line()) : file; };
             for (size_t k = 0; k < corners; ++k) {
                 const tinyobj::index_t& idx = shape.mesh.indices[offset + k];
                 if (idx.vertex_index < 0 || idx.vertex_index >= nv)
                     throw Error(where(), "face references vertex " + std::to_string(idx.vertex_index + 1) +
                                              " but the file has " + std::to_string(nv) +
                                              " vertices (index out of range)");
-                if (idx.normal_index >= nn || idx.normal_index < -1)
-                    throw Error(where(), "face references normal " + std::to_string(idx.normal_index + 1) +
-                                             " but the file has " + std::to_string(nn) +
-                                             " normals (index out of range)");
-                if (idx.texcoord_index >= nt || idx.texcoord_index < -1)
-                    throw Error(where(), "face references texture coordinate " +
-                                             std::to_string(idx.texcoord_index + 1) + " but the file has " +
-                                             std::to_string(nt) + " (index out of range)");
-                all_normals &= idx.normal_index >= 0;
-                all_uvs &= idx.texcoord_index >= 0;
+                // Normals and uvs are optional: exporters that write "f 1/1/1" without any
+                // vt lines are common, so a bad normal/uv index only drops that attribute.
+                if ((idx.normal_index >= nn || idx.normal_index < -1) && !bad_normal_line) bad_normal_line = where_line();
+                if ((idx.texcoord_index >= nt || idx.texcoord_index < -1) && !bad_uv_line) bad_uv_line = where_line();
+                all_normals &= idx.normal_index >= 0 && idx.normal_index < nn;
+                all_uvs &= idx.texcoord_index >= 0 && idx.texcoord_index < nt;
             }
             const int mat = f < shape.mesh.material_ids.size() ? shape.mesh.material_ids[f] : -1;
             if (mat >= int(materials.size())) throw Error(where(), "face uses an unknown material");
             offset += corners;
         }
     }
+
+    if (bad_normal_line)
+        scene.warnings.push_back(file + ":" + std::to_string(bad_normal_line) +
+                                 ": normal index out of range; vertex normals ignored");
+    if (bad_uv_line)
+        scene.warnings.push_back(file + ":" + std::to_string(bad_uv_line) +
+                                 ": texture coordinate index out of range; texture coordinates ignored");
 
     Mesh mesh;
     mesh.name = scene.name;

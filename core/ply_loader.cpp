@@ -70,6 +70,63 @@ std::optional<DeclaredCounts> off_header_counts(const fs::path& path) {
     }
 }
 
+// CGAL rejects a bad OFF file without saying why; re-read it line by line to name the
+// problem (only called after CGAL failed).
+std::string diagnose_off(const fs::path& path, const DeclaredCounts& declared) {
+    std::ifstream in(path, std::ios::binary);
+    std::vector<std::vector<std::string>> lines;  // non-empty lines, comments removed
+    std::string line;
+    while (std::getline(in, line)) {
+        line = line.substr(0, line.find('#'));
+        std::istringstream s(line);
+        std::vector<std::string> tokens;
+        std::string tok;
+        while (s >> tok) tokens.push_back(tok);
+        if (!tokens.empty()) lines.push_back(std::move(tokens));
+    }
+    // Header: "OFF" and the counts, on one line or two.
+    size_t at = 0;
+    if (!lines.empty() && lines[0][0].find("OFF") != std::string::npos) at = lines[0].size() > 1 ? 1 : 2;
+    else at = 1;
+    auto truncated = [&](const std::string& what) {
+        return "truncated OFF: the header declares " + std::to_string(declared.vertices) + " vertices and " +
+               std::to_string(declared.faces) + " faces, but the file ends before " + what;
+    };
+    for (size_t v = 0; v < declared.vertices; ++v, ++at) {
+        if (at >= lines.size()) return truncated("vertex " + std::to_string(v));
+        if (lines[at].size() < 3) return "vertex " + std::to_string(v) + " has fewer than 3 coordinates";
+        for (size_t k = 0; k < 3; ++k) {
+            const std::string& t = lines[at][k];
+            char* end = nullptr;
+            const double x = std::strtod(t.c_str(), &end);
+            if (end == t.c_str() || *end != '\0') return "vertex " + std::to_string(v) + " coordinate '" + t + "' is not a number";
+            if (!std::isfinite(x)) return "vertex " + std::to_string(v) + " coordinate '" + t + "' is not finite";
+        }
+    }
+    for (size_t f = 0; f < declared.faces; ++f, ++at) {
+        if (at >= lines.size()) return truncated("face " + std::to_string(f));
+        const auto& tokens = lines[at];
+        size_t n = 0;
+        try {
+            n = std::stoul(tokens[0]);
+        } catch (const std::exception&) {
+            return "face " + std::to_string(f) + " does not start with a vertex count";
+        }
+        if (tokens.size() < 1 + n) return "face " + std::to_string(f) + " lists fewer vertices than it declares (truncated?)";
+        for (size_t k = 1; k <= n; ++k) {
+            long long idx = -1;
+            try {
+                idx = std::stoll(tokens[k]);
+            } catch (const std::exception&) {
+            }
+            if (idx < 0 || size_t(idx) >= declared.vertices)
+                return "face " + std::to_string(f) + " references vertex " + tokens[k] + " but the file has " +
+                       std::to_string(declared.vertices) + " vertices (index out of range)";
+        }
+    }
+    return "malformed OFF (could not be parsed)";
+}
+
 std::string lower_extension(const fs::path& path) {
     std::string ext = path.extension().string();
     for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
@@ -104,6 +161,7 @@ Scene load_ply_or_off(const fs::path& path) {
                               " vertices and " + std::to_string(declared->faces) + " faces, but only " +
                               std::to_string(points.size()) + " vertices and " + std::to_string(polygons.size()) +
                               " faces could be read");
+    if (!ok && ext == ".off" && declared) throw Error(file, diagnose_off(path, *declared));
     if (!ok) throw Error(file, "malformed " + format + " (could not be parsed)");
 
     Mesh mesh;

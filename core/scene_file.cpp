@@ -5,6 +5,7 @@
 
 #include <fstream>
 #include <map>
+#include <set>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include "core/error.hpp"
@@ -138,6 +139,8 @@ struct SceneBuilder {
     Scene scene;
     std::map<std::string, uint32_t> named_materials;
     std::map<std::string, Scene> loaded;  // by resolved path: a file used twice loads once
+    std::map<std::string, std::pair<std::string, std::set<std::string>>> warning_counts;  // text after the file name
+    std::vector<std::string> warning_order;
 
     uint32_t add_material(const Material& m) {
         for (size_t i = 0; i < scene.materials.size(); ++i)
@@ -190,7 +193,22 @@ struct SceneBuilder {
             scene.lights.push_back(light);
         }
         scene.degenerate_triangles_dropped += sub.degenerate_triangles_dropped;
-        scene.warnings.insert(scene.warnings.end(), sub.warnings.begin(), sub.warnings.end());
+        // The same note from many files (e.g. 174 kitchen parts) is reported once.
+        for (const std::string& w : sub.warnings) {
+            std::string what = w;
+            if (what.rfind(sub.source, 0) == 0) what = what.substr(sub.source.size());
+            auto [it, inserted] = warning_counts.try_emplace(what, w, std::set<std::string>{});
+            it->second.second.insert(sub.source);
+            if (inserted) warning_order.push_back(what);
+        }
+    }
+
+    void finish_warnings() {
+        for (const std::string& what : warning_order) {
+            const auto& [first, sources] = warning_counts[what];
+            const size_t n = sources.size();
+            scene.warnings.push_back(n <= 1 ? first : first + " (and " + std::to_string(n - 1) + " more files)");
+        }
     }
 
     // Bounds of the subtree rooted at `root` (every node after it belongs to it), with
@@ -299,7 +317,7 @@ struct SceneBuilder {
             if (e.contains("fit_to_box")) {
                 const std::string bp = ptr + "/fit_to_box";
                 const json& box = e["fit_to_box"];
-                in.check_object(box, bp, {"min", "max"});
+                in.check_object(box, bp, {"min", "max", "anchor"});
                 if (!box.contains("min") || !box.contains("max")) in.fail(bp, "needs both 'min' and 'max'");
                 const Vec3 lo = in.vec3(box["min"], bp + "/min"), hi = in.vec3(box["max"], bp + "/max");
                 if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z)) in.fail(bp, "'max' must exceed 'min' on every axis");
@@ -312,9 +330,15 @@ struct SceneBuilder {
                 for (int c = 0; c < 3; ++c)
                     if (extent[c] > 0) s = std::min(s, target[c] / extent[c]);
                 if (!std::isfinite(s)) s = 1.0f;  // a single point: keep its size
+                // "center": centred in the box; "bottom": centred in x and z, resting on min.y.
+                std::string anchor = "center";
+                if (box.contains("anchor")) anchor = in.string(box["anchor"], bp + "/anchor");
+                if (anchor != "center" && anchor != "bottom")
+                    in.fail(bp + "/anchor", "expected 'center' or 'bottom', got '" + anchor + "'");
                 Transform fitted = rotate_only;
                 fitted.scale = Vec3(s);
                 fitted.translation = 0.5f * (lo + hi) - s * b.center();
+                if (anchor == "bottom") fitted.translation.y = lo.y - s * b.min.y;
                 scene.nodes[entry_index].local = fitted;
             }
         }
@@ -555,12 +579,13 @@ Scene load_scene_file(const fs::path& path, const AssetPaths& assets) {
 
     Reader in(file);
     in.check_object(doc, "", {"name", "description", "materials", "meshes", "lights", "camera", "hmd", "animation"});
-    SceneBuilder b{in, assets, path.parent_path(), {}, {}, {}, {}};
+    SceneBuilder b{in, assets, path.parent_path(), {}, {}, {}, {}, {}, {}};
     b.scene.name = doc.contains("name") ? in.string(doc["name"], "/name") : path.stem().string();
     b.scene.source = file;
     if (doc.contains("description")) in.string(doc["description"], "/description");
     b.read_materials(doc);
     b.read_meshes(doc);
+    b.finish_warnings();
     b.read_lights(doc);
     b.read_camera(doc);
     b.read_hmd(doc);

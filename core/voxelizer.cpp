@@ -18,9 +18,9 @@
 namespace gilab {
 namespace {
 
-constexpr int kMaxBrickLog2 = 8;          // bricks of at most 256³ voxels (2 MiB bitmaps)
-constexpr size_t kBigBrickTriangles = 1024;  // above this a brick's triangles run in parallel
-constexpr size_t kBatchBricks = 64;
+constexpr int kMaxBrickLog2 = 6;              // bricks of at most 64³ voxels (32 KiB bitmaps)
+constexpr size_t kBigBrickTriangles = 16384;  // above this a brick's triangles run in parallel
+constexpr size_t kBatchBricks = 256;          // bricks voxelized concurrently, then appended in order
 constexpr double kCoarsePad = 1e-6;  // voxels
 
 // A triangle in voxel units, prepared for many box tests: its bounding box plus the

@@ -2,7 +2,7 @@
 // Conservative surface voxelization: a voxel is occupied when its closed box overlaps a
 // triangle (Akenine-Möller's separating-axis triangle/box test). The output is the
 // Morton-sorted list of unique occupied voxel coordinates, identical at any thread
-// count. Work streams over aligned bricks of at most 256³ voxels, so memory is the
+// count. Work streams over aligned bricks of at most 64³ voxels, so memory is the
 // output list plus a few brick bitmaps — never resolution³. A sub-region of the grid
 // can be voxelized alone (cascades, and split builds that go one octree subtree at a time).
 #include <cstdint>

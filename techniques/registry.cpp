@@ -2,6 +2,7 @@
 
 #include "core/error.hpp"
 #include "techniques/path_tracer/path_tracer.hpp"
+#include "techniques/photon_mapping/photon_technique.hpp"
 
 namespace gilab {
 
@@ -30,6 +31,7 @@ const TechniqueRegistry& TechniqueRegistry::builtin() {
     static const TechniqueRegistry registry = [] {
         TechniqueRegistry r;
         register_path_tracer(r);
+        register_photon_mapping(r);
         return r;
     }();
     return registry;

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -95,7 +96,8 @@ Film test_film(int w, int h, float seed) {
     for (const char* name : {"color", "direct", "normal", "depth", "weights"}) {
         for (float& v : film.layer(name).data) {
             // Values that would not survive a half-float or 8-bit detour.
-            v = seed * std::sin(0.37f * float(++k)) * std::pow(10.0f, float(k % 11) - 5.0f);
+            ++k;
+            v = seed * std::sin(0.37f * float(k)) * std::pow(10.0f, float(k % 11) - 5.0f);
         }
     }
     film.layer("depth").data[3] = std::numeric_limits<float>::infinity();

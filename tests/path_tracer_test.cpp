@@ -64,7 +64,9 @@ Scene furnace(float albedo, float emission) {
     return scene;
 }
 
-EyeCamera furnace_camera() { return EyeCamera::look_at(Vec3(0), Vec3(0, 0, -1), Vec3(0, 1, 0), 90.0f, 32, 32); }
+EyeCamera furnace_camera(int size = 32) {
+    return EyeCamera::look_at(Vec3(0), Vec3(0, 0, -1), Vec3(0, 1, 0), 90.0f, size, size);
+}
 
 struct FurnaceCase {
     float albedo, emission;
@@ -74,9 +76,9 @@ class Furnace : public ::testing::TestWithParam<FurnaceCase> {};
 
 TEST_P(Furnace, ConvergesToEmissionOverOneMinusAlbedo) {
     const auto [a, E] = GetParam();
-    const int spp = 16;
+    const int spp = 64;
     // Russian roulette keeps it unbiased; max_depth is only a safety net (a^1000 ≈ 0).
-    Film film = render(furnace(a, E), furnace_camera(),
+    Film film = render(furnace(a, E), furnace_camera(48),
                        {{"spp", spp}, {"max_depth", 1000}, {"rr_depth", 3}, {"seed", 7}});
     const double expected = E / (1.0 - a);
     for (int c = 0; c < 3; ++c) {
@@ -236,8 +238,11 @@ TEST(PathTracer, PlaneUnderAreaLightMatchesAnalyticIrradiance) {
                 ASSERT_FALSE(std::abs(q.x) <= 0.3f && std::abs(q.z) <= 0.2f) << "the light is visible; move the camera";
             }
             auto p = plane_point(camera, x, y, 0.0f);
-            ASSERT_TRUE(p.has_value());
-            double expected = kPlaneAlbedo.x * kInvPi * polygon_irradiance(*p, Vec3(0, 1, 0), quad, 10.0);
+            if (p && (std::abs(p->x) > 20.0f || std::abs(p->z) > 20.0f)) p.reset();
+            double expected = p ? kPlaneAlbedo.x * kInvPi * polygon_irradiance(*p, Vec3(0, 1, 0), quad, 10.0) : 0.0;
+            if (!p) {
+                EXPECT_EQ(film.get("color", x, y), Vec3(0));  // escaped: nothing to see
+            }
             double got = film.get("color", x, y).x;
             sum_diff += got - expected;
             sum_diff2 += (got - expected) * (got - expected);
@@ -329,11 +334,12 @@ TEST(PathTracer, CornellBoxLayersAreConsistent) {
             ASSERT_TRUE(is_finite(c));
             EXPECT_GE(std::min({c.x, c.y, c.z}), 0.0f);
             EXPECT_EQ(c, d + i);
-            EXPECT_GT(film.get("depth", x, y).x, 0.0f);  // the box is closed towards the camera's view
+            EXPECT_GE(film.get("depth", x, y).x, 0.0f);
             total += c.x;
         }
     }
     EXPECT_GT(total, 0.0);
+    EXPECT_GT(film.get("depth", 12, 12).x, 1.0f);  // the back wall, beyond the opening
     EXPECT_EQ(stats.get("samples"), 24.0 * 24.0 * 4.0);
     EXPECT_GE(stats.get("rays"), 24.0 * 24.0 * 4.0);
     EXPECT_EQ(stats.get("nonfinite_samples"), 0.0);

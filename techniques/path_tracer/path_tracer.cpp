@@ -33,14 +33,19 @@ void add_light(PathSample& s, int bounces, const Vec3& value) {
 
 bool is_black(const Vec3& v) { return v.x <= 0.0f && v.y <= 0.0f && v.z <= 0.0f; }
 
-// A shadow ray from a surface towards a light sample, stopping just short of it.
+// A shadow ray from a surface towards a light sample, stopping just short of it. It is
+// aimed from the offset origin at the sample point itself: a ray parallel to wi would be
+// shifted off the light point and could hit the emitter's own plane before tmax.
 Ray shadow_ray(const SurfaceInteraction& si, const LightSample& ls) {
     Ray r;
     r.origin = si.spawn_origin(ls.wi);
     r.direction = ls.wi;
     if (std::isinf(ls.distance)) return r;
     Vec3 target = si.position + ls.distance * ls.wi;
-    float dist = glm::length(target - r.origin);
+    Vec3 d = target - r.origin;
+    float dist = glm::length(d);
+    if (!(dist > 0.0f)) return r;
+    r.direction = d / dist;
     r.tmax = std::max(0.0f, dist - ray_epsilon(target));
     return r;
 }
@@ -208,7 +213,7 @@ void PathTracer::render(const ViewSet& views, std::vector<Film>& films) {
         if (views.views.size() > 1 && v < views.names.size()) label += " " + views.names[v];
         Progress progress(label, tiles);
         const int spp = settings_.spp;
-        const float inv_spp = 1.0f / float(spp);
+        const double inv_spp = 1.0 / double(spp);
 
         parallel_for_tiles(width, height, ts, [&](const Tile& tile) {
             uint64_t tile_rays = 0, tile_dropped = 0;
@@ -217,8 +222,8 @@ void PathTracer::render(const ViewSet& views, std::vector<Film>& films) {
                     const size_t pixel = size_t(y) * size_t(width) + size_t(x);
                     // Samples are summed in order by this one task: thread count never
                     // changes the floating-point result.
-                    Vec3 sum_direct(0), sum_indirect(0), sum_albedo(0), sum_normal(0);
-                    float sum_depth = 0;
+                    DVec3 sum_direct(0), sum_indirect(0), sum_albedo(0), sum_normal(0);
+                    double sum_depth = 0;
                     int hits = 0;
                     for (int s = 0; s < spp; ++s) {
                         Rng rng = Rng::for_sample(settings_.seed, pixel, uint64_t(s), uint64_t(v));
@@ -229,19 +234,19 @@ void PathTracer::render(const ViewSet& views, std::vector<Film>& films) {
                             ++tile_dropped;  // counted and reported, never averaged in
                             continue;
                         }
-                        sum_direct += ps.direct;
-                        sum_indirect += ps.indirect;
+                        sum_direct += DVec3(ps.direct);
+                        sum_indirect += DVec3(ps.indirect);
                         if (ps.hit) {
-                            sum_albedo += ps.albedo;
-                            sum_normal += ps.normal;
+                            sum_albedo += DVec3(ps.albedo);
+                            sum_normal += DVec3(ps.normal);
                             sum_depth += ps.depth;
                             ++hits;
                         }
                     }
-                    Vec3 d = sum_direct * inv_spp, i = sum_indirect * inv_spp;
+                    Vec3 d = Vec3(sum_direct * inv_spp), i = Vec3(sum_indirect * inv_spp);
                     Vec3 c = d + i;
-                    Vec3 a = sum_albedo * inv_spp;
-                    Vec3 nrm = glm::length(sum_normal) > 0 ? glm::normalize(sum_normal) : Vec3(0);
+                    Vec3 a = Vec3(sum_albedo * inv_spp);
+                    Vec3 nrm = glm::length(sum_normal) > 0 ? Vec3(glm::normalize(sum_normal)) : Vec3(0);
                     for (int k = 0; k < 3; ++k) {
                         color[3 * pixel + k] = c[k];
                         direct[3 * pixel + k] = d[k];
@@ -249,7 +254,7 @@ void PathTracer::render(const ViewSet& views, std::vector<Film>& films) {
                         albedo[3 * pixel + k] = a[k];
                         normal[3 * pixel + k] = nrm[k];
                     }
-                    depth[pixel] = hits > 0 ? sum_depth / float(hits) : 0.0f;
+                    depth[pixel] = hits > 0 ? float(sum_depth / hits) : 0.0f;
                 }
             }
             rays += tile_rays;

@@ -9,8 +9,10 @@
 // Settings: spp (16), seed (1), max_depth (8), rr_depth (3), tile_size (16),
 // jitter (true: sample positions jittered inside the pixel; false: pixel centres).
 // Layers: color, direct (emission seen directly + one-bounce lighting), indirect
-// (two or more bounces; color = direct + indirect), albedo, normal (world-space shading
-// normal at the first hit), depth (distance from the eye to the first hit; 0 for misses).
+// (two or more bounces; color = direct + indirect), albedo (diffuse + specular
+// reflectance at the first hit), normal (world-space shading normal at the first hit),
+// depth (distance from the eye to the first hit; 0 for misses). Samples whose value is
+// not finite are dropped and counted in stats "nonfinite_samples".
 #include <cstdint>
 #include <memory>
 #include <optional>

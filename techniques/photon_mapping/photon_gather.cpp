@@ -1,0 +1,207 @@
+#include "techniques/photon_mapping/photon_gather.hpp"
+
+#include "core/bsdf.hpp"
+#include "core/error.hpp"
+#include "core/morton.hpp"
+
+namespace gilab {
+
+namespace {
+
+constexpr int kLanes = 8;
+
+// Σ ΔΦ over photons within r arriving from above the surface, over runs of a SoA, with
+// 8 partial sums (a loop the compiler turns into SIMD; lane l takes elements l, l+8, ...
+// of each run, so the sum depends only on the runs' contents and boundaries).
+Vec3 sum_flux_runs(const PhotonSoAView& v, const PhotonRun* runs, size_t count, const Vec3& x, const Vec3& n,
+                   float r2, uint64_t& visited, uint64_t& inside) {
+    alignas(32) float ar[kLanes] = {}, ag[kLanes] = {}, ab[kLanes] = {};
+    alignas(32) uint32_t ac[kLanes] = {};
+    const float qx = x.x, qy = x.y, qz = x.z, nx = n.x, ny = n.y, nz = n.z;
+    auto lane = [&](int l, uint32_t j) {
+        float dx = qx - v.x[j], dy = qy - v.y[j], dz = qz - v.z[j];
+        float d2 = dx * dx + dy * dy + dz * dz;
+        float c = v.wx[j] * nx + v.wy[j] * ny + v.wz[j] * nz;
+        bool in = d2 <= r2;
+        float w = (in && c > 0.0f) ? 1.0f : 0.0f;
+        ar[l] += w * v.r[j];
+        ag[l] += w * v.g[j];
+        ab[l] += w * v.b[j];
+        ac[l] += in ? 1u : 0u;
+    };
+    uint64_t seen = 0;
+    for (size_t k = 0; k < count; ++k) {
+        uint32_t i = runs[k].begin;
+        const uint32_t end = runs[k].end;
+        seen += end - i;
+        for (; i + kLanes <= end; i += kLanes)
+            for (int l = 0; l < kLanes; ++l) lane(l, i + uint32_t(l));
+        for (int l = 0; i < end; ++i, ++l) lane(l, i);
+    }
+    Vec3 sum(0.0f);
+    uint64_t in = 0;
+    for (int l = 0; l < kLanes; ++l) {
+        sum.x += ar[l];
+        sum.y += ag[l];
+        sum.z += ab[l];
+        in += ac[l];
+    }
+    visited += seen;
+    inside += in;
+    return sum;
+}
+
+}  // namespace
+
+PhotonGatherer::PhotonGatherer(const PhotonMap& map, const std::vector<Material>& materials, GatherMode mode,
+                               float radius, size_t k)
+    : map_(map), materials_(materials), mode_(mode), radius_(radius), radius2_(radius * radius),
+      inv_area_(1.0f / (kPi * radius * radius)), k_(k) {
+    if (!(radius > 0.0f)) throw Error("photon gather", "radius must be positive");
+    grid_ = dynamic_cast<const HashGridPhotonMap*>(&map);
+    kd_ = dynamic_cast<const KdTreePhotonMap*>(&map);
+    nano_ = dynamic_cast<const NanoflannPhotonMap*>(&map);
+    if (grid_ && !grid_->empty() && grid_->radius() != radius)
+        throw Error("photon gather", "the hash grid was built for another radius; build it again");
+    Bounds3 box;
+    for (uint32_t i = 0; i < map.size(); ++i) box.extend(map.photon(i).position);
+    key_origin_ = box.empty() ? Vec3(0) : box.min - radius;
+}
+
+Vec3 PhotonGatherer::finish(const Material& m, const Vec3& sum) const {
+    if (m.has_glossy_lobe()) return sum * inv_area_;
+    return bsdf_diffuse(m) * (sum * inv_area_);
+}
+
+Vec3 PhotonGatherer::sum_over_runs(const PhotonSoAView& v, const PhotonRun* runs, size_t count, const GatherPoint& p,
+                                   GatherScratch& scratch, PhotonQueryStats& stats) const {
+    const Material& m = materials_[p.material];
+    const bool glossy = m.has_glossy_lobe();
+    if (mode_ == GatherMode::Radius && !glossy)
+        return sum_flux_runs(v, runs, count, p.position, p.normal, radius2_, stats.visited, stats.inside);
+
+    // Scalar paths: per-photon BSDF (glossy) or the heap (kNN), same run order.
+    Vec3 sum(0.0f);
+    uint64_t visited = 0, inside = 0;
+    NeighborHeap& heap = scratch.heap;
+    if (mode_ == GatherMode::Knn) heap.reset(k_, radius2_);
+    for (size_t k = 0; k < count; ++k) {
+        visited += runs[k].size();
+        for (uint32_t j = runs[k].begin; j < runs[k].end; ++j) {
+            float d2 = photon_distance2(p.position, v.x[j], v.y[j], v.z[j]);
+            if (!(d2 <= radius2_)) continue;
+            ++inside;
+            Vec3 w(v.wx[j], v.wy[j], v.wz[j]);
+            if (!(glm::dot(w, p.normal) > 0.0f)) continue;
+            if (mode_ == GatherMode::Knn) {
+                heap.offer(j, d2);
+            } else {
+                sum += bsdf_eval(m, p.normal, p.wo, w) * Vec3(v.r[j], v.g[j], v.b[j]);
+            }
+        }
+    }
+    if (mode_ == GatherMode::Knn) {
+        for (const PhotonNeighbor& nb : heap.items()) {
+            Vec3 power(v.r[nb.index], v.g[nb.index], v.b[nb.index]);
+            if (glossy) {
+                Vec3 w(v.wx[nb.index], v.wy[nb.index], v.wz[nb.index]);
+                sum += bsdf_eval(m, p.normal, p.wo, w) * power;
+            } else {
+                sum += power;
+            }
+        }
+    }
+    stats.visited += visited;
+    stats.inside += inside;
+    return sum;
+}
+
+Vec3 PhotonGatherer::estimate(const GatherPoint& p, GatherScratch& scratch, PhotonQueryStats& stats) const {
+    const Material& m = materials_[p.material];
+    const bool glossy = m.has_glossy_lobe();
+    if (grid_) {
+        ++stats.queries;
+        PhotonRun runs[27];
+        size_t count = 0;
+        grid_->for_each_run(p.position, radius_, [&](PhotonRun r) {
+            if (count < 27) runs[count++] = r;
+        });
+        return finish(m, sum_over_runs(grid_->view(), runs, count, p, scratch, stats));
+    }
+    // Trees: photons come from the structure's own traversal.
+    Vec3 sum(0.0f);
+    auto front = [&](uint32_t i) { return glm::dot(map_.photon(i).wi.unpack(), p.normal) > 0.0f; };
+    auto add = [&](uint32_t i) {
+        const Photon& ph = map_.photon(i);
+        sum += glossy ? bsdf_eval(m, p.normal, p.wo, ph.incoming()) * ph.power : ph.power;
+    };
+    if (mode_ == GatherMode::Radius) {
+        auto visit = [&](uint32_t i, float) {
+            if (front(i)) add(i);
+        };
+        if (kd_)
+            kd_->for_each_in_radius(p.position, radius_, visit, stats);
+        else
+            map_.radius_query(p.position, radius_, visit, stats);
+    } else {
+        NeighborHeap& heap = scratch.heap;
+        if (kd_)
+            kd_->knn(p.position, k_, radius_, heap, stats, front);
+        else if (nano_)
+            nano_->knn_filtered(p.position, k_, radius_, heap, stats, front);
+        else
+            throw Error("photon gather", "no kNN filter for this structure");
+        for (const PhotonNeighbor& nb : heap.items()) add(nb.index);
+    }
+    return finish(m, sum);
+}
+
+glm::ivec3 PhotonGatherer::cell_of(const Vec3& x) const {
+    if (grid_) return grid_->cell_of(x);
+    Vec3 c = glm::floor((x - key_origin_) / radius_);
+    glm::ivec3 out;
+    for (int a = 0; a < 3; ++a) out[a] = c[a] >= -1e9f && c[a] <= 1e9f ? int(c[a]) : -1000000000;
+    return out;
+}
+
+uint64_t PhotonGatherer::coherence_key(const Vec3& x) const {
+    glm::ivec3 c = cell_of(x);
+    UVec3 u;
+    for (int a = 0; a < 3; ++a) u[a] = uint32_t(std::clamp(c[a] + 1, 0, int(kMortonMaxCoordinate)));
+    return morton_encode(u);
+}
+
+void PhotonGatherer::estimate_group(const glm::ivec3& cell, std::span<const GatherPoint* const> points,
+                                    std::span<Vec3> out, GatherScratch& scratch, PhotonQueryStats& stats) const {
+    if (!grid_) throw Error("photon gather", "tile-shared gather needs the hash grid");
+    // Fetch the neighbourhood once, run by run, into the local buffer (Algorithm 1).
+    PhotonSoA& local = scratch.local;
+    std::vector<PhotonRun>& local_runs = scratch.local_runs;
+    local_runs.clear();
+    uint32_t total = 0;
+    grid_->for_each_run(cell, radius_, [&](PhotonRun r) {
+        local_runs.push_back({total, total + r.size()});
+        total += r.size();
+    });
+    if (local.size() < total) local.resize(total);
+    const PhotonSoA& src = grid_->soa();
+    size_t k = 0;
+    grid_->for_each_run(cell, radius_, [&](PhotonRun r) {
+        const uint32_t dst = local_runs[k++].begin, n = r.size();
+        auto copy = [&](const std::vector<float>& a, std::vector<float>& b) {
+            std::copy_n(a.data() + r.begin, n, b.data() + dst);
+        };
+        copy(src.x, local.x), copy(src.y, local.y), copy(src.z, local.z);
+        copy(src.wx, local.wx), copy(src.wy, local.wy), copy(src.wz, local.wz);
+        copy(src.r, local.r), copy(src.g, local.g), copy(src.b, local.b);
+    });
+    scratch.fetched += total;
+    const PhotonSoAView view = PhotonSoAView::of(local);
+    for (size_t i = 0; i < points.size(); ++i) {
+        const GatherPoint& p = *points[i];
+        ++stats.queries;
+        out[i] = finish(materials_[p.material], sum_over_runs(view, local_runs.data(), local_runs.size(), p, scratch, stats));
+    }
+}
+
+}  // namespace gilab

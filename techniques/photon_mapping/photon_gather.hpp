@@ -1,0 +1,78 @@
+#pragma once
+// Density estimation (P1 eq. 1): reflected radiance at a surface point from the photons
+// around it, L ≈ 1/(π r²) Σ f_r(x, ω_p, ω) ΔΦ_p, with the disk estimator over a fixed r.
+// f_r is the view-independent diffuse part ρ/π for Lambertian materials (one multiply
+// after summing the flux) and the full BSDF (diffuse + glossy lobe) per photon for
+// glossy ones; photons arriving from below the surface (ω_p·n ≤ 0) contribute nothing.
+//
+// Modes: Radius sums every photon within r (no heap); Knn keeps the k nearest within r
+// in a max-heap and sums those (with the same 1/(π r²), so a full heap under-counts
+// dense regions: the darkening of the paper's Fig. 8).
+//
+// With the hash grid the sums run over contiguous runs of its structure-of-arrays in a
+// fixed lane order (8 partial sums), so the result depends only on the point, whatever
+// pass order (fused/split) or grouping (tile-shared) is used; estimate_group fetches a
+// cell's neighbourhood once into a local buffer with the same run boundaries and so
+// returns bit-identical values.
+#include <cstdint>
+#include <span>
+#include <vector>
+#include "accel/hash_grid_photon_map.hpp"
+#include "accel/kd_tree_photon_map.hpp"
+#include "accel/nanoflann_photon_map.hpp"
+#include "core/material.hpp"
+
+namespace gilab {
+
+enum class GatherMode { Radius, Knn };
+
+struct GatherPoint {
+    Vec3 position{0};
+    Vec3 normal{0};       // shading normal on the viewer's side
+    Vec3 wo{0};           // towards the viewer
+    uint32_t material = 0;
+};
+
+// Per-thread working memory.
+struct GatherScratch {
+    NeighborHeap heap;
+    PhotonSoA local;                    // tile-shared neighbourhood copy
+    std::vector<PhotonRun> local_runs;
+    uint64_t fetched = 0;               // photons copied into local buffers
+};
+
+class PhotonGatherer {
+public:
+    PhotonGatherer(const PhotonMap& map, const std::vector<Material>& materials, GatherMode mode, float radius, size_t k);
+
+    // Σ f_r ΔΦ / (π r²) at p.
+    Vec3 estimate(const GatherPoint& p, GatherScratch& scratch, PhotonQueryStats& stats) const;
+
+    // Tile-shared gather (needs the hash grid): every point must lie in `cell`.
+    bool supports_groups() const { return grid_ != nullptr; }
+    glm::ivec3 cell_of(const Vec3& x) const;
+    void estimate_group(const glm::ivec3& cell, std::span<const GatherPoint* const> points, std::span<Vec3> out,
+                        GatherScratch& scratch, PhotonQueryStats& stats) const;
+
+    // A sort key that puts points near each other (same cell first) next to each other.
+    uint64_t coherence_key(const Vec3& x) const;
+
+    float radius() const { return radius_; }
+
+private:
+    Vec3 finish(const Material& m, const Vec3& sum) const;
+    Vec3 sum_over_runs(const PhotonSoAView& v, const PhotonRun* runs, size_t count, const GatherPoint& p,
+                       GatherScratch& scratch, PhotonQueryStats& stats) const;
+
+    const PhotonMap& map_;
+    const HashGridPhotonMap* grid_ = nullptr;
+    const KdTreePhotonMap* kd_ = nullptr;
+    const NanoflannPhotonMap* nano_ = nullptr;
+    const std::vector<Material>& materials_;
+    GatherMode mode_;
+    float radius_, radius2_, inv_area_;
+    size_t k_;
+    Vec3 key_origin_{0};
+};
+
+}  // namespace gilab

@@ -1,0 +1,78 @@
+#pragma once
+// Small generated meshes and voxel sets shared by the voxel-structure tests.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+#include "core/math.hpp"
+#include "core/morton.hpp"
+#include "core/voxel_grid.hpp"
+
+namespace gilab::test {
+
+struct TriangleSoup {
+    std::vector<Vec3> positions;
+    std::vector<UVec3> triangles;
+
+    void add(const Vec3& a, const Vec3& b, const Vec3& c) {
+        uint32_t base = static_cast<uint32_t>(positions.size());
+        positions.insert(positions.end(), {a, b, c});
+        triangles.push_back(UVec3(base, base + 1, base + 2));
+    }
+};
+
+// A latitude/longitude sphere.
+inline TriangleSoup uv_sphere(const Vec3& center, float radius, int rings = 12, int segments = 24) {
+    TriangleSoup m;
+    for (int r = 0; r <= rings; ++r) {
+        float theta = kPi * float(r) / float(rings);
+        for (int s = 0; s <= segments; ++s) {
+            float phi = 2.0f * kPi * float(s) / float(segments);
+            m.positions.push_back(center + radius * Vec3(std::sin(theta) * std::cos(phi), std::cos(theta),
+                                                         std::sin(theta) * std::sin(phi)));
+        }
+    }
+    auto idx = [&](int r, int s) { return uint32_t(r * (segments + 1) + s); };
+    for (int r = 0; r < rings; ++r)
+        for (int s = 0; s < segments; ++s) {
+            if (r > 0) m.triangles.push_back(UVec3(idx(r, s), idx(r + 1, s), idx(r, s + 1)));
+            if (r + 1 < rings) m.triangles.push_back(UVec3(idx(r, s + 1), idx(r + 1, s), idx(r + 1, s + 1)));
+        }
+    return m;
+}
+
+inline Vec3 random_point(std::mt19937& rng, const Vec3& lo, const Vec3& hi) {
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    return lo + (hi - lo) * Vec3(u(rng), u(rng), u(rng));
+}
+
+// Triangles with corners anywhere in [lo, hi].
+inline TriangleSoup random_triangles(std::mt19937& rng, int count, const Vec3& lo, const Vec3& hi) {
+    TriangleSoup m;
+    for (int i = 0; i < count; ++i) m.add(random_point(rng, lo, hi), random_point(rng, lo, hi), random_point(rng, lo, hi));
+    return m;
+}
+
+// Random occupied voxels (each with probability `fill`), as ascending Morton codes.
+inline std::vector<uint64_t> random_voxels(std::mt19937& rng, uint32_t n, double fill) {
+    std::bernoulli_distribution keep(fill);
+    std::vector<uint64_t> codes;
+    for (uint32_t z = 0; z < n; ++z)
+        for (uint32_t y = 0; y < n; ++y)
+            for (uint32_t x = 0; x < n; ++x)
+                if (keep(rng)) codes.push_back(morton_encode(x, y, z));
+    std::sort(codes.begin(), codes.end());
+    return codes;
+}
+
+// The unit cube grid [0,1]^3 at resolution n.
+inline VoxelGrid unit_grid(uint32_t n) {
+    VoxelGrid g;
+    g.origin = Vec3(0);
+    g.extent = 1.0f;
+    g.resolution = n;
+    return g;
+}
+
+}  // namespace gilab::test
