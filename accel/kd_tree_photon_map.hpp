@@ -47,8 +47,9 @@ public:
                 float delta = x[axis] - p.position[axis];
                 uint32_t near_child = delta < 0.0f ? 2 * node : 2 * node + 1;
                 uint32_t far_child = near_child ^ 1u;
+                // A node with one child has only the left one (2i); the right may be missing.
                 if (delta * delta <= r2 && far_child <= n) stack[top++] = far_child;
-                stack[top++] = near_child;
+                if (near_child <= n) stack[top++] = near_child;
             }
             ++visited;
             float d2 = photon_distance2(x, p.position.x, p.position.y, p.position.z);
@@ -92,7 +93,7 @@ public:
                 uint32_t far_child = near_child ^ 1u;
                 float plane2 = delta * delta;
                 if (plane2 <= heap.bound2() && far_child <= n) stack[top++] = {far_child, plane2};
-                stack[top++] = {near_child, 0.0f};
+                if (near_child <= n) stack[top++] = {near_child, 0.0f};
             }
             ++visited;
             float d2 = photon_distance2(x, p.position.x, p.position.y, p.position.z);

@@ -8,6 +8,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include "accel/esvo.hpp"
 #include "accel/svdag.hpp"
@@ -166,6 +167,21 @@ void BM_SvdagSplitFromMesh(benchmark::State& state) {
 }
 // Args: resolution, log2 of the cell size converted at once.
 BENCHMARK(BM_SvdagSplitFromMesh)->Args({512, 8})->Args({1000, 8})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+
+// Large grids only on request (GILAB_BENCH_LARGE=1): the 2000³ SVO path and split
+// builds at 2000³, 4096³ and 8192³ (the last takes about half a minute on 2 cores).
+const bool kLargeRegistered = [] {
+    if (!std::getenv("GILAB_BENCH_LARGE")) return false;
+    benchmark::RegisterBenchmark("BM_SvoToSvdag", BM_SvoToSvdag)->Arg(2000)->Unit(benchmark::kMillisecond)->UseRealTime();
+    benchmark::RegisterBenchmark("BM_SvdagSplitFromMesh", BM_SvdagSplitFromMesh)
+        ->Args({2000, 8})
+        ->Args({4096, 10})
+        ->Args({8192, 10})
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime()
+        ->Iterations(1);
+    return true;
+}();
 
 // Fig. 13: primary rays from a fixed viewpoint, 256×256 pinhole camera.
 std::vector<Ray> primary_rays(const VoxelGrid& g, int width) {

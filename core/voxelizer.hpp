@@ -61,8 +61,9 @@ public:
     VoxelList voxelize() const;
     VoxelList voxelize(const VoxelRegion& region) const;
 
-    // Upper estimate of the occupied voxels inside a region (projected triangle areas
-    // plus edge lengths, in voxels, capped by the region volume).
+    // Estimate of the occupied voxels inside a region: projected triangle areas plus
+    // edge lengths, in voxels, capped by the region volume. On smooth meshes it is
+    // about twice the true count (shared edges and voxels are counted per triangle).
     uint64_t estimate_voxels(const VoxelRegion& region) const;
     // Aligned cells of 2^cell_log2 voxels per axis that some triangle overlaps, as the
     // Morton codes of the cell coordinates (cell = voxel >> cell_log2), ascending.

@@ -62,5 +62,6 @@ ExperimentOutput run_and_write(const Experiment& experiment, ExperimentContext c
 
 // Registration functions, one per paper/module (called from registry.cpp only).
 void register_core_experiments(ExperimentRegistry& registry);
+void register_photon_experiments(ExperimentRegistry& registry);    // P1: pm-table1..4, pm-fig8
 
 }  // namespace gilab

@@ -6,6 +6,7 @@ const ExperimentRegistry& ExperimentRegistry::builtin() {
     static const ExperimentRegistry registry = [] {
         ExperimentRegistry r;
         register_core_experiments(r);
+        register_photon_experiments(r);
         return r;
     }();
     return registry;

@@ -79,6 +79,7 @@ OpenedScene open_scene(const std::string& spec, const AssetPaths& assets) {
         fs::path resolved = fs::exists(path) ? path : assets.resolve(spec);
         opened.scene = load_mesh_file(resolved);
     }
+    opened.warnings.insert(opened.warnings.end(), opened.scene.warnings.begin(), opened.scene.warnings.end());
     if (opened.scene.degenerate_triangles_dropped > 0)
         opened.warnings.push_back(std::to_string(opened.scene.degenerate_triangles_dropped) +
                                   " zero-area triangles dropped");

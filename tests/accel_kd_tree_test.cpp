@@ -79,6 +79,29 @@ TEST(KdTree, RadiusQueryEqualsBruteForce) {
     }
 }
 
+TEST(KdTree, EveryNodeIsVisitedOnceAndNoneBeyond) {
+    // Trees of every small size, including those whose last interior node has only a
+    // left child: an unbounded query must visit each node exactly once.
+    for (size_t n = 1; n <= 40; ++n) {
+        auto photons = test::random_photons(n, uint32_t(n));
+        KdTreePhotonMap tree;
+        tree.build(photons);
+        for (const Vec3& x : {Vec3(-1.0f), Vec3(2.0f), Vec3(0.5f), Vec3(2.0f, -1.0f, 0.5f)}) {
+            PhotonQueryStats stats;
+            std::vector<uint32_t> seen;
+            tree.radius_query(x, 100.0f, [&](uint32_t i, float) { seen.push_back(i); }, stats);
+            EXPECT_EQ(stats.visited, n);
+            EXPECT_EQ(seen.size(), n);
+            for (uint32_t i : seen) EXPECT_LT(i, n);
+            NeighborHeap heap;
+            PhotonQueryStats knn_stats;
+            tree.knn_query(x, n + 5, 100.0f, heap, knn_stats);
+            EXPECT_EQ(heap.size(), n);
+            EXPECT_LE(knn_stats.visited, n);
+        }
+    }
+}
+
 TEST(KdTree, KnnEqualsBruteForce) {
     const auto photons = test::random_photons(3000, 19);
     KdTreePhotonMap tree;

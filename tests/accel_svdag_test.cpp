@@ -61,8 +61,9 @@ void check_storage(const Svdag& dag) {
                 ASSERT_TRUE(bytes >= 8 && bytes <= 36);
                 for (int i = 0; i < k; ++i) ASSERT_TRUE(next_level.count(words[a + 1 + i])) << "level " << l;
                 for (int s = 0; s < 8; ++s)
-                    if (mask & (1u << s))
+                    if (mask & (1u << s)) {
                         ASSERT_EQ(dag.child(a, s), words[a + 1 + std::popcount(mask & ((1u << s) - 1))]);
+                    }
             } else {
                 ASSERT_EQ(k, 0);
             }
@@ -113,7 +114,9 @@ TEST(Svdag, SplitBuildsGiveTheSameDag) {
         // Ids follow first appearance in Morton order either way, so even the words agree.
         EXPECT_TRUE(std::equal(dag.words().begin(), dag.words().end(), whole.words().begin(), whole.words().end()))
             << "split level " << split;
-        if (split > 0) EXPECT_GT(dag.build_stats().subtrees, 1u);
+        if (split > 0) {
+            EXPECT_GT(dag.build_stats().subtrees, 1u);
+        }
     }
 }
 
@@ -184,7 +187,9 @@ TEST(Svdag, PathAndBoxRoundTrip) {
         EXPECT_EQ(*back, p);
         // The box's centre lies in the cell, so its leaf path starts with p.
         auto leaf = point_to_path(g, box.center());
-        if (leaf) EXPECT_TRUE(std::equal(p.slots.begin(), p.slots.end(), leaf->slots.begin()));
+        if (leaf) {
+            EXPECT_TRUE(std::equal(p.slots.begin(), p.slots.end(), leaf->slots.begin()));
+        }
     }
     EXPECT_THROW(path_to_cell(OctreePath{{1, 2, 3, 4, 5, 6, 7}}, depth), Error);
     EXPECT_THROW(path_to_cell(OctreePath{{9}}, depth), Error);
@@ -243,7 +248,9 @@ TEST(DagLevelTable, SameKeySameIdAcrossGrowth) {
         uint32_t id = table.find_or_insert(key[0], key.data() + 1, uint32_t(key.size() - 1));
         auto [it, fresh] = first_id.emplace(key, id);
         ASSERT_EQ(it->second, id);
-        if (fresh) ASSERT_EQ(id, first_id.size() - 1) << "ids are dense, in order of first insertion";
+        if (fresh) {
+            ASSERT_EQ(id, first_id.size() - 1) << "ids are dense, in order of first insertion";
+        }
     }
     EXPECT_EQ(table.size(), distinct.size());
     for (const auto& [key, id] : first_id) {

@@ -33,8 +33,9 @@ void check_structure(const Svo& svo, const std::vector<uint64_t>& codes) {
     EXPECT_EQ(svo.pointer_count(), interior);
     for (size_t i = 0; i < interior; ++i) {
         ASSERT_NE(svo.mask(uint32_t(i)), 0);
-        if (i + 1 < interior)
+        if (i + 1 < interior) {
             ASSERT_EQ(svo.first_child(uint32_t(i + 1)), svo.first_child(uint32_t(i)) + std::popcount(svo.mask(uint32_t(i))));
+        }
     }
     for (size_t i = interior; i < svo.node_count(); ++i) ASSERT_EQ(svo.mask(uint32_t(i)), 0);
     EXPECT_EQ(svo.bytes(), svo.node_count() + 4 * interior);

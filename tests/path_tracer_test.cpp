@@ -100,8 +100,10 @@ TEST_P(Furnace, ConvergesToEmissionOverOneMinusAlbedo) {
     EXPECT_NEAR(indirect.mean, E * a * a / (1 - a), 3 * indirect.standard_error);
 }
 
-INSTANTIATE_TEST_SUITE_P(PathTracer, Furnace,
-                         ::testing::Values(FurnaceCase{0.5f, 1.0f}, FurnaceCase{0.8f, 0.5f}));
+INSTANTIATE_TEST_SUITE_P(PathTracer, Furnace, ::testing::Values(FurnaceCase{0.5f, 1.0f}, FurnaceCase{0.8f, 0.5f}),
+                         [](const ::testing::TestParamInfo<FurnaceCase>& info) {
+                             return "albedo_" + std::to_string(int(std::lround(info.param.albedo * 100)));
+                         });
 
 TEST(PathTracer, FurnaceTruncatedAtMaxDepthSumsTheFirstBounces) {
     // Without Russian roulette and at most 2 bounces: E(1 + a + a²).

@@ -48,7 +48,10 @@ inline std::vector<uint32_t> brute_radius(const std::vector<Photon>& photons, co
 inline std::vector<uint32_t> map_radius(const PhotonMap& map, const Vec3& x, float r, PhotonQueryStats* stats = nullptr) {
     std::vector<uint32_t> out;
     PhotonQueryStats local;
-    map.radius_query(x, r, [&](uint32_t i, float d2) { out.push_back(map.original_index(i)); }, stats ? *stats : local);
+    map.radius_query(x, r, [&](uint32_t i, float d2) {
+        // An index past the end would be a read outside the structure.
+        out.push_back(i < map.size() ? map.original_index(i) : 0xffffffffu);
+    }, stats ? *stats : local);
     std::sort(out.begin(), out.end());
     return out;
 }
@@ -85,7 +88,7 @@ inline KnnAnswer map_knn(const PhotonMap& map, const Vec3& x, size_t k, float r)
     KnnAnswer a;
     for (const PhotonNeighbor& n : heap.items()) {
         a.distances2.push_back(n.distance2);
-        a.indices.push_back(map.original_index(n.index));
+        a.indices.push_back(n.index < map.size() ? map.original_index(n.index) : 0xffffffffu);
     }
     std::sort(a.distances2.begin(), a.distances2.end());
     std::sort(a.indices.begin(), a.indices.end());

@@ -15,19 +15,22 @@ constexpr int kLanes = 8;
 // of each run, so the sum depends only on the runs' contents and boundaries).
 Vec3 sum_flux_runs(const PhotonSoAView& v, const PhotonRun* runs, size_t count, const Vec3& x, const Vec3& n,
                    float r2, uint64_t& visited, uint64_t& inside) {
-    alignas(32) float ar[kLanes] = {}, ag[kLanes] = {}, ab[kLanes] = {};
-    alignas(32) uint32_t ac[kLanes] = {};
+    alignas(32) float ar[kLanes] = {}, ag[kLanes] = {}, ab[kLanes] = {}, ac[kLanes] = {};
     const float qx = x.x, qy = x.y, qz = x.z, nx = n.x, ny = n.y, nz = n.z;
+    const float *px = v.x, *py = v.y, *pz = v.z, *wx = v.wx, *wy = v.wy, *wz = v.wz;
+    const float *pr = v.r, *pg = v.g, *pb = v.b;
+    // Branch-free lane body: masks as 0/1 factors (a photon's flux times 0 or 1 is exact,
+    // and per-lane counts stay far below 2^24, so float counters are exact too).
     auto lane = [&](int l, uint32_t j) {
-        float dx = qx - v.x[j], dy = qy - v.y[j], dz = qz - v.z[j];
+        float dx = qx - px[j], dy = qy - py[j], dz = qz - pz[j];
         float d2 = dx * dx + dy * dy + dz * dz;
-        float c = v.wx[j] * nx + v.wy[j] * ny + v.wz[j] * nz;
-        bool in = d2 <= r2;
-        float w = (in && c > 0.0f) ? 1.0f : 0.0f;
-        ar[l] += w * v.r[j];
-        ag[l] += w * v.g[j];
-        ab[l] += w * v.b[j];
-        ac[l] += in ? 1u : 0u;
+        float c = wx[j] * nx + wy[j] * ny + wz[j] * nz;
+        float in = d2 <= r2 ? 1.0f : 0.0f;
+        float w = c > 0.0f ? in : 0.0f;
+        ar[l] += w * pr[j];
+        ag[l] += w * pg[j];
+        ab[l] += w * pb[j];
+        ac[l] += in;
     };
     uint64_t seen = 0;
     for (size_t k = 0; k < count; ++k) {
@@ -39,7 +42,7 @@ Vec3 sum_flux_runs(const PhotonSoAView& v, const PhotonRun* runs, size_t count, 
         for (int l = 0; i < end; ++i, ++l) lane(l, i);
     }
     Vec3 sum(0.0f);
-    uint64_t in = 0;
+    float in = 0.0f;
     for (int l = 0; l < kLanes; ++l) {
         sum.x += ar[l];
         sum.y += ag[l];
@@ -47,7 +50,7 @@ Vec3 sum_flux_runs(const PhotonSoAView& v, const PhotonRun* runs, size_t count, 
         in += ac[l];
     }
     visited += seen;
-    inside += in;
+    inside += uint64_t(in);
     return sum;
 }
 

@@ -6,6 +6,7 @@
 #include <mutex>
 #include <numeric>
 #include <sstream>
+#include <tbb/parallel_sort.h>
 #include "core/bsdf.hpp"
 #include "core/error.hpp"
 #include "core/interaction.hpp"
@@ -242,14 +243,23 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, uint64_t view,
         groups += local_groups;
         grouped_hits += local_grouped;
     };
+    // Hits in cell order (Morton order of cells, then the cell, then the slot: a total
+    // order, so the parallel sort is deterministic).
     auto sort_items = [&](const std::vector<HitRecord>& hits, const std::vector<uint32_t>& slots) {
-        std::vector<SortItem> items;
-        items.reserve(slots.size());
-        for (uint32_t p : slots) {
-            const Vec3& x = hits[p].point.position;
-            items.push_back({gatherer.coherence_key(x), gatherer.cell_of(x), p});
+        std::vector<SortItem> items(slots.size());
+        auto fill = [&](size_t b, size_t e) {
+            for (size_t i = b; i < e; ++i) {
+                const Vec3& x = hits[slots[i]].point.position;
+                items[i] = {gatherer.coherence_key(x), gatherer.cell_of(x), slots[i]};
+            }
+        };
+        if (items.size() < 4096) {
+            fill(0, items.size());
+            std::sort(items.begin(), items.end());
+        } else {
+            parallel_for(items.size(), 2048, fill);
+            tbb::parallel_sort(items.begin(), items.end());
         }
-        std::sort(items.begin(), items.end());
         return items;
     };
 
