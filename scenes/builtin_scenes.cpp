@@ -96,7 +96,7 @@ Scene make_cornell_box() {
     // Head placed where the eyes see the whole opening of the box; HMD looks down +Z.
     SceneHmd hmd;
     hmd.preset = "vive";
-    hmd.pose.position = Vec3(278, 273, -300) * kCornellScale;
+    hmd.pose.position = Vec3(278, 273, -180) * kCornellScale;
     hmd.pose.orientation = glm::angleAxis(kPi, Vec3(0, 1, 0));  // camera −Z → world +Z
     scene.hmd = hmd;
     return scene;
