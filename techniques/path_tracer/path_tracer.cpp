@@ -81,31 +81,16 @@ void PathTracer::prepare(const Scene& scene, const Settings& settings) {
     Stopwatch watch;
     settings_ = PathTracerSettings::from(settings);
     config_hash_ = settings.hash();
-    scene.validate();
-    materials_ = scene.materials;
-    if (scene.is_animated())
-        animated_scene_ = scene;
-    else
-        animated_scene_.reset();
-    tracer_.reset();
-    frame_ = scene.evaluate(0.0);
-    tracer_ = std::make_unique<RayTracer>(frame_);
-    lights_ = LightSampler(frame_, materials_);
+    scene_.load(scene);
     stats_ = Stats();
     stats_.set("prepare_ms", watch.elapsed_ms());
-    stats_.set("triangles", double(frame_.triangle_count()));
-    stats_.set("lights", double(lights_.light_count()));
+    stats_.set("triangles", double(scene_.frame().triangle_count()));
+    stats_.set("lights", double(scene_.lights().light_count()));
 }
 
 void PathTracer::update(double time) {
-    if (!tracer_) throw Error("path", "update() called before prepare()");
-    if (!animated_scene_) return;  // static: every time looks the same
-    Stopwatch watch;
-    frame_ = animated_scene_->evaluate(time);
-    RayTracer::UpdateKind kind = tracer_->update(frame_);
-    lights_ = LightSampler(frame_, materials_);
-    stats_.set("update_ms", watch.elapsed_ms());
-    stats_.set("bvh_rebuilt", kind == RayTracer::UpdateKind::Rebuild ? 1.0 : 0.0);
+    if (!scene_.loaded()) throw Error("path", "update() called before prepare()");
+    scene_.set_time(time, &stats_);
 }
 
 namespace {
@@ -183,9 +168,9 @@ struct Tracer {
 }  // namespace
 
 void PathTracer::render(const ViewSet& views, std::vector<Film>& films) {
-    if (!tracer_) throw Error("path", "render() called before prepare()");
+    if (!scene_.loaded()) throw Error("path", "render() called before prepare()");
     Stopwatch watch;
-    const Tracer tracer{*tracer_, frame_, materials_, lights_, settings_};
+    const Tracer tracer{scene_.tracer(), scene_.frame(), scene_.materials(), scene_.lights(), settings_};
     std::atomic<uint64_t> rays{0}, dropped{0};
     films.resize(views.views.size());
     double samples = 0;

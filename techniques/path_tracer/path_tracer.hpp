@@ -14,11 +14,8 @@
 // depth (distance from the eye to the first hit; 0 for misses). Samples whose value is
 // not finite are dropped and counted in stats "nonfinite_samples".
 #include <cstdint>
-#include <memory>
-#include <optional>
 #include <string>
-#include "core/light_sampler.hpp"
-#include "core/ray_tracer.hpp"
+#include "core/traced_scene.hpp"
 #include "techniques/technique.hpp"
 
 namespace gilab {
@@ -49,11 +46,7 @@ public:
 private:
     PathTracerSettings settings_;
     std::string config_hash_;
-    std::optional<Scene> animated_scene_;  // kept only when update(t) has work to do
-    std::vector<Material> materials_;
-    SceneFrame frame_;                     // the ray tracer points at this member
-    std::unique_ptr<RayTracer> tracer_;
-    LightSampler lights_;
+    TracedScene scene_;
     Stats stats_;
 };
 
