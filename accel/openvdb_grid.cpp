@@ -38,6 +38,7 @@ const VoxelGrid& OpenVdbVoxels::grid() const { return impl_->grid; }
 uint64_t OpenVdbVoxels::voxel_count() const { return impl_->vdb->activeVoxelCount(); }
 size_t OpenVdbVoxels::bytes() const { return impl_->vdb->memUsage(); }
 size_t OpenVdbVoxels::leaf_node_count() const { return impl_->vdb->tree().leafCount(); }
+size_t OpenVdbVoxels::internal_node_count() const { return impl_->vdb->tree().nonLeafCount() - 1; }
 double OpenVdbVoxels::build_ms() const { return impl_->build_ms; }
 
 bool OpenVdbVoxels::contains_voxel(const UVec3& v) const {

@@ -24,6 +24,7 @@ public:
     uint64_t voxel_count() const;     // activeVoxelCount()
     size_t bytes() const;             // memUsage()
     size_t leaf_node_count() const;   // 8³ leaf nodes
+    size_t internal_node_count() const;  // 16³ and 32³ internal nodes (the root not counted)
     bool contains_voxel(const UVec3& voxel) const;
     bool occupied(const Vec3& world_point) const;  // through OpenVDB's own transform
     double build_ms() const;

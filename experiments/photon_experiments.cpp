@@ -144,43 +144,58 @@ struct Measured {
     Film film;
 };
 
-Measured measure(const Setup& setup, const ExperimentContext& ctx, nlohmann::json settings) {
-    settings["seed"] = setup.seed;
-    settings["light_samples"] = kLightSamples;
-    auto technique = TechniqueRegistry::builtin().create("photon");
-    Settings s(settings, "pm experiment settings");
-    technique->prepare(setup.scene, s);
-    s.report_unused();
-    Measured m;
-    Stats prepared = technique->stats();
-    m.trace_ms = prepared.get("photon_trace_ms");
-    m.build_ms = prepared.get("photon_build_ms");
-    m.stored = prepared.get("photons_stored");
-    // Every per-frame figure is the median over the frames (other processes share the CPU).
-    std::map<std::string, std::vector<double>> per_frame;
-    std::vector<Film> films;
+// Prepares every variant, then renders them in turn, frame by frame (A B C A B C ...), so
+// a change in machine load hits all variants alike; every per-frame figure is the median
+// over the frames.
+std::vector<Measured> measure(const Setup& setup, const ExperimentContext& ctx, std::vector<nlohmann::json> variants) {
+    const size_t n = variants.size();
+    std::vector<std::unique_ptr<Technique>> techniques;
+    std::vector<Measured> results(n);
+    for (size_t v = 0; v < n; ++v) {
+        variants[v]["seed"] = setup.seed;
+        variants[v]["light_samples"] = kLightSamples;
+        techniques.push_back(TechniqueRegistry::builtin().create("photon"));
+        Settings s(variants[v], "pm experiment settings");
+        techniques[v]->prepare(setup.scene, s);
+        s.report_unused();
+        Stats prepared = techniques[v]->stats();
+        results[v].trace_ms = prepared.get("photon_trace_ms");
+        results[v].build_ms = prepared.get("photon_build_ms");
+        results[v].stored = prepared.get("photons_stored");
+    }
     const char* keys[] = {"render_ms", "trace_pass_ms", "sort_ms", "gather_pass_ms", "tile_groups",
                           "tile_grouped_hits", "tile_fetched_photons", "gather_queries"};
-    Stats frame;
+    std::vector<std::map<std::string, std::vector<double>>> per_frame(n);
+    std::vector<Stats> last(n);
+    std::vector<Film> films(n);
     int frames = setup.frames;
     for (int f = 0; f < frames; ++f) {
-        technique->render(ViewSet::mono(setup.camera), films);
-        if (f == 0 && technique->stats().get("render_ms") > 2000.0) frames = std::min(frames, 3);  // slow variants
-        frame = technique->stats();
-        for (const char* key : keys) per_frame[key].push_back(frame.get(key));
+        double slowest = 0;
+        for (size_t v = 0; v < n; ++v) {
+            std::vector<Film> out;
+            techniques[v]->render(ViewSet::mono(setup.camera), out);
+            last[v] = techniques[v]->stats();
+            for (const char* key : keys) per_frame[v][key].push_back(last[v].get(key));
+            slowest = std::max(slowest, last[v].get("render_ms"));
+            films[v] = std::move(out.at(0));
+        }
+        if (f == 0 && slowest > 2000.0) frames = std::min(frames, 3);  // slow variants
     }
-    m.frame_ms = median(per_frame["render_ms"]);
-    m.extra["frames"] = double(frames);
-    m.visited_per_hit = frame.get("photons_visited_per_hit");
-    m.inside_fraction = frame.get("inside_fraction");
-    for (const char* key : keys) m.extra[key] = median(per_frame[key]);
-    m.film = std::move(films.at(0));
-    m.relmse_color = relative_mse(m.film, setup.reference, "color");
-    m.relmse_indirect = relative_mse(m.film, setup.reference, "indirect");
-    m.mean_indirect = mean_value(m.film, "indirect");
-    m.mean_color = mean_value(m.film, "color");
-    ctx.say(settings.dump() + ": " + std::to_string(m.frame_ms) + " ms");
-    return m;
+    for (size_t v = 0; v < n; ++v) {
+        Measured& m = results[v];
+        m.frame_ms = median(per_frame[v]["render_ms"]);
+        m.extra["frames"] = double(frames);
+        m.visited_per_hit = last[v].get("photons_visited_per_hit");
+        m.inside_fraction = last[v].get("inside_fraction");
+        for (const char* key : keys) m.extra[key] = median(per_frame[v][key]);
+        m.film = std::move(films[v]);
+        m.relmse_color = relative_mse(m.film, setup.reference, "color");
+        m.relmse_indirect = relative_mse(m.film, setup.reference, "indirect");
+        m.mean_indirect = mean_value(m.film, "indirect");
+        m.mean_color = mean_value(m.film, "color");
+        ctx.say(variants[v].dump() + ": " + std::to_string(m.frame_ms) + " ms");
+    }
+    return results;
 }
 
 // The columns every table shares, after the row's own leading columns.
@@ -219,7 +234,8 @@ void common_notes(ExperimentOutput& out, const Setup& setup) {
     out.notes.push_back("frame_ms = one render(): primary rays, " + std::to_string(kLightSamples) +
                         " shadow ray(s) per hit and the photon gather, at " + std::to_string(setup.size) + "×" +
                         std::to_string(setup.size) + "; median over " + std::to_string(setup.frames) +
-                        " frames (3 when a frame takes over 2 s). Photon tracing (photon_trace_ms) and building the map (build_ms) happen once in "
+                        " frames (3 when a frame takes over 2 s), the variants of a row rendered in turn frame by "
+                        "frame so that load changes hit them alike. Photon tracing (photon_trace_ms) and building the map (build_ms) happen once in "
                         "prepare() and are reported separately.");
     out.notes.push_back("visited_per_hit = photons whose distance was computed per gather; inside_fraction = share of "
                         "them within r (the paper's worst case for the 27-cell grid is (4/3)π/27 ≈ 15.5 %).");
@@ -245,15 +261,19 @@ ExperimentOutput run_table1(const ExperimentContext& ctx) {
     ratios.columns = {"photons", "r", "hash/kd", "paper hash/kd", "hash/nanoflann", "kd/nanoflann"};
     for (const PaperRow& p : kTable1) {
         std::map<std::string, double> ms;
-        for (const char* map : {"kd_tree", "hash_grid", "nanoflann"}) {
-            nlohmann::json s = {{"photons", photon_side(p.side, ctx.quick) * photon_side(p.side, ctx.quick)},
-                                {"radius", p.radius}, {"gather", "knn"}, {"k", kHeapSize}, {"photon_map", map}};
-            Measured m = measure(setup, ctx, s);
-            ms[map] = m.frame_ms;
+        const std::vector<std::string> maps = {"kd_tree", "hash_grid", "nanoflann"};
+        std::vector<nlohmann::json> variants;
+        for (const std::string& map : maps)
+            variants.push_back({{"photons", photon_side(p.side, ctx.quick) * photon_side(p.side, ctx.quick)},
+                                {"radius", p.radius}, {"gather", "knn"}, {"k", kHeapSize}, {"photon_map", map}});
+        std::vector<Measured> measured = measure(setup, ctx, variants);
+        for (size_t i = 0; i < maps.size(); ++i) {
+            const std::string& map = maps[i];
+            ms[map] = measured[i].frame_ms;
             std::optional<double> paper;
-            if (std::string(map) == "kd_tree") paper = p.first;
-            if (std::string(map) == "hash_grid") paper = p.second;
-            t.rows.push_back(row(p, ctx.quick, map, m, paper));
+            if (map == "kd_tree") paper = p.first;
+            if (map == "hash_grid") paper = p.second;
+            t.rows.push_back(row(p, ctx.quick, map, measured[i], paper));
         }
         ratios.rows.push_back({{"photons", squared(photon_side(p.side, ctx.quick))},
                                {"r", p.radius},
@@ -292,7 +312,8 @@ ExperimentOutput run_table2(const ExperimentContext& ctx) {
         heap["gather"] = "knn";
         heap["k"] = kHeapSize;
         none["gather"] = "radius";
-        Measured a = measure(setup, ctx, heap), b = measure(setup, ctx, none);
+        auto pair = measure(setup, ctx, {heap, none});
+        const Measured &a = pair[0], &b = pair[1];
         t.rows.push_back(row(p, ctx.quick, "heap", a, p.first));
         t.rows.push_back(row(p, ctx.quick, "no heap", b, p.second));
         ratios.rows.push_back({{"photons", squared(side)},
@@ -329,7 +350,8 @@ ExperimentOutput run_table3(const ExperimentContext& ctx) {
         nlohmann::json fused = base, split = base;
         fused["pass"] = "fused";
         split["pass"] = "split";
-        Measured a = measure(setup, ctx, fused), b = measure(setup, ctx, split);
+        auto pair = measure(setup, ctx, {fused, split});
+        Measured &a = pair[0], &b = pair[1];
         nlohmann::json ra = row(p, ctx.quick, "fused", a, p.first), rb = row(p, ctx.quick, "split", b, p.second);
         for (const char* key : {"trace_pass_ms", "sort_ms", "gather_pass_ms"}) {
             ra[key] = nlohmann::json();
@@ -373,17 +395,18 @@ ExperimentOutput run_table4(const ExperimentContext& ctx) {
         nlohmann::json off = base, on = base;
         off["tile_shared"] = false;
         on["tile_shared"] = true;
-        Measured a = measure(setup, ctx, off), b = measure(setup, ctx, on);
+        auto pair = measure(setup, ctx, {off, on});
+        const Measured &a = pair[0], &b = pair[1];
         nlohmann::json ra = row(p, ctx.quick, "per-hit gather", a, p.first);
         nlohmann::json rb = row(p, ctx.quick, "tile-shared", b, p.second);
-        for (auto* pair : {&ra, &rb}) {
-            const Measured& m = pair == &ra ? a : b;
-            (*pair)["gather_pass_ms"] = m.extra.at("gather_pass_ms");
+        for (auto* out_row : {&ra, &rb}) {
+            const Measured& m = out_row == &ra ? a : b;
+            (*out_row)["gather_pass_ms"] = m.extra.at("gather_pass_ms");
             double queries = std::max(1.0, m.extra.at("gather_queries"));
             double groups = m.extra.at("tile_groups");
-            (*pair)["grouped_hits_fraction"] = m.extra.at("tile_grouped_hits") / queries;
-            (*pair)["hits_per_group"] = groups > 0 ? nlohmann::json(m.extra.at("tile_grouped_hits") / groups)
-                                                   : nlohmann::json();
+            (*out_row)["grouped_hits_fraction"] = m.extra.at("tile_grouped_hits") / queries;
+            (*out_row)["hits_per_group"] = groups > 0 ? nlohmann::json(m.extra.at("tile_grouped_hits") / groups)
+                                                      : nlohmann::json();
         }
         t.rows.push_back(ra);
         t.rows.push_back(rb);
@@ -419,10 +442,13 @@ ExperimentOutput run_fig8(const ExperimentContext& ctx) {
     t.columns = {"variant", "image", "frame_ms", "mean_color", "mean_indirect", "indirect vs reference",
                  "relmse_indirect", "relmse_color"};
     const double ref_indirect = mean_value(setup.reference, "indirect");
+    std::vector<nlohmann::json> variants;
+    for (bool heap : {true, false})
+        variants.push_back({{"photons", side * side}, {"radius", r}, {"photon_map", "hash_grid"},
+                            {"gather", heap ? "knn" : "radius"}, {"k", kHeapSize}});
+    std::vector<Measured> measured = measure(setup, ctx, variants);
     for (bool heap : {true, false}) {
-        nlohmann::json s = {{"photons", side * side}, {"radius", r}, {"photon_map", "hash_grid"},
-                            {"gather", heap ? "knn" : "radius"}, {"k", kHeapSize}};
-        Measured m = measure(setup, ctx, s);
+        const Measured& m = measured[heap ? 0 : 1];
         const std::string stem = heap ? "fig8_heap128" : "fig8_noheap";
         write_exr(ctx.output_dir / (stem + ".exr"), m.film);
         write_png(ctx.output_dir / (stem + ".png"), m.film);

@@ -3,6 +3,7 @@
 #include "core/error.hpp"
 #include "techniques/path_tracer/path_tracer.hpp"
 #include "techniques/photon_mapping/photon_technique.hpp"
+#include "techniques/vct/vct_technique.hpp"
 
 namespace gilab {
 
@@ -32,6 +33,7 @@ const TechniqueRegistry& TechniqueRegistry::builtin() {
         TechniqueRegistry r;
         register_path_tracer(r);
         register_photon_mapping(r);
+        register_vct(r);
         return r;
     }();
     return registry;

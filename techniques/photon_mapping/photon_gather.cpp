@@ -12,8 +12,12 @@ constexpr int kLanes = 8;
 
 // Σ ΔΦ over photons within r arriving from above the surface, over runs of a SoA, with
 // 8 partial sums (a loop the compiler turns into SIMD; lane l takes elements l, l+8, ...
-// of each run, so the sum depends only on the runs' contents and boundaries).
-Vec3 sum_flux_runs(const PhotonSoAView& v, const PhotonRun* runs, size_t count, const Vec3& x, const Vec3& n,
+// of each run, so the sum depends only on the runs' contents and boundaries). Compiled
+// twice, for AVX2 (one 8-wide vector per step) and the SSE2 baseline (two 4-wide
+// vectors), chosen at load time. Each lane performs the same IEEE operations in the same
+// order either way (no FMA contraction in ISO C++ mode), so the two should agree bit for
+// bit; within one process only one of them is ever used.
+__attribute__((target_clones("avx2", "default"))) Vec3 sum_flux_runs(const PhotonSoAView& v, const PhotonRun* runs, size_t count, const Vec3& x, const Vec3& n,
                    float r2, uint64_t& visited, uint64_t& inside) {
     alignas(32) float ar[kLanes] = {}, ag[kLanes] = {}, ab[kLanes] = {}, ac[kLanes] = {};
     const float qx = x.x, qy = x.y, qz = x.z, nx = n.x, ny = n.y, nz = n.z;
@@ -21,7 +25,9 @@ Vec3 sum_flux_runs(const PhotonSoAView& v, const PhotonRun* runs, size_t count, 
     const float *pr = v.r, *pg = v.g, *pb = v.b;
     // Branch-free lane body: masks as 0/1 factors (a photon's flux times 0 or 1 is exact,
     // and per-lane counts stay far below 2^24, so float counters are exact too).
-    auto lane = [&](int l, uint32_t j) {
+    // (size_t indices: with 32-bit ones the compiler cannot prove that lanes are adjacent
+    // in memory, since 32-bit arithmetic may wrap, and builds vectors element by element.)
+    auto lane = [&](int l, size_t j) {
         float dx = qx - px[j], dy = qy - py[j], dz = qz - pz[j];
         float d2 = dx * dx + dy * dy + dz * dz;
         float c = wx[j] * nx + wy[j] * ny + wz[j] * nz;
@@ -34,11 +40,11 @@ Vec3 sum_flux_runs(const PhotonSoAView& v, const PhotonRun* runs, size_t count, 
     };
     uint64_t seen = 0;
     for (size_t k = 0; k < count; ++k) {
-        uint32_t i = runs[k].begin;
-        const uint32_t end = runs[k].end;
+        size_t i = runs[k].begin;
+        const size_t end = runs[k].end;
         seen += end - i;
         for (; i + kLanes <= end; i += kLanes)
-            for (int l = 0; l < kLanes; ++l) lane(l, i + uint32_t(l));
+            for (int l = 0; l < kLanes; ++l) lane(l, i + size_t(l));
         for (int l = 0; i < end; ++i, ++l) lane(l, i);
     }
     Vec3 sum(0.0f);
@@ -66,9 +72,11 @@ PhotonGatherer::PhotonGatherer(const PhotonMap& map, const std::vector<Material>
     nano_ = dynamic_cast<const NanoflannPhotonMap*>(&map);
     if (grid_ && !grid_->empty() && grid_->radius() != radius)
         throw Error("photon gather", "the hash grid was built for another radius; build it again");
-    Bounds3 box;
-    for (uint32_t i = 0; i < map.size(); ++i) box.extend(map.photon(i).position);
-    key_origin_ = box.empty() ? Vec3(0) : box.min - radius;
+    if (!grid_) {  // the trees' sort keys use r-sized cells from the photons' minimum
+        Bounds3 box;
+        for (uint32_t i = 0; i < map.size(); ++i) box.extend(map.photon(i).position);
+        key_origin_ = box.empty() ? Vec3(0) : box.min - radius;
+    }
 }
 
 Vec3 PhotonGatherer::finish(const Material& m, const Vec3& sum) const {
@@ -167,8 +175,13 @@ glm::ivec3 PhotonGatherer::cell_of(const Vec3& x) const {
     return out;
 }
 
-uint64_t PhotonGatherer::coherence_key(const Vec3& x) const {
+uint64_t PhotonGatherer::sort_key(const Vec3& x, uint32_t slot) const {
     glm::ivec3 c = cell_of(x);
+    if (grid_) {
+        const glm::ivec3 g = grid_->grid_size();
+        bool inside = c.x >= 0 && c.y >= 0 && c.z >= 0 && c.x < g.x && c.y < g.y && c.z < g.z;
+        return inside ? uint64_t(grid_->hash(c)) : (kUngrouped | slot);
+    }
     UVec3 u;
     for (int a = 0; a < 3; ++a) u[a] = uint32_t(std::clamp(c[a] + 1, 0, int(kMortonMaxCoordinate)));
     return morton_encode(u);

@@ -54,8 +54,12 @@ public:
     void estimate_group(const glm::ivec3& cell, std::span<const GatherPoint* const> points, std::span<Vec3> out,
                         GatherScratch& scratch, PhotonQueryStats& stats) const;
 
-    // A sort key that puts points near each other (same cell first) next to each other.
-    uint64_t coherence_key(const Vec3& x) const;
+    // A sort key that puts points near each other next to each other. With the hash grid
+    // it is the cell's hash for points in the grid (equal keys ⇔ same cell, so sorted
+    // runs of equal keys are tile-shared groups) and unique (≥ 2^63, from `slot`) for
+    // points outside it; otherwise the Morton code of an r-sized cell.
+    uint64_t sort_key(const Vec3& x, uint32_t slot) const;
+    static constexpr uint64_t kUngrouped = uint64_t(1) << 63;
 
     float radius() const { return radius_; }
 

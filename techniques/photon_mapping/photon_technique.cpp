@@ -49,16 +49,10 @@ struct HitRecord {
 };
 
 struct SortItem {
-    uint64_t key;
-    glm::ivec3 cell;
+    uint64_t key;   // PhotonGatherer::sort_key
     uint32_t slot;  // index into the hit buffer
-    bool operator<(const SortItem& o) const {
-        if (key != o.key) return key < o.key;
-        if (cell.x != o.cell.x) return cell.x < o.cell.x;
-        if (cell.y != o.cell.y) return cell.y < o.cell.y;
-        if (cell.z != o.cell.z) return cell.z < o.cell.z;
-        return slot < o.slot;
-    }
+    bool operator<(const SortItem& o) const { return key != o.key ? key < o.key : slot < o.slot; }
+    bool same_group(const SortItem& o) const { return key == o.key && key < PhotonGatherer::kUngrouped; }
 };
 
 }  // namespace
@@ -225,12 +219,12 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, uint64_t view,
         for (size_t i = b; i < e;) {
             size_t j = i + 1;
             if (shared)
-                while (j < e && items[j].cell == items[i].cell) ++j;
+                while (j < e && items[j].same_group(items[i])) ++j;
             if (j - i >= 2) {
                 points.clear();
                 for (size_t t = i; t < j; ++t) points.push_back(&hits[items[t].slot].point);
                 out.resize(points.size());
-                gatherer.estimate_group(items[i].cell, points, out, scratch, qs);
+                gatherer.estimate_group(gatherer.cell_of(points[0]->position), points, out, scratch, qs);
                 for (size_t t = i; t < j; ++t) write_indirect(hits[items[t].slot].pixel, out[t - i]);
                 ++local_groups;
                 local_grouped += j - i;
@@ -243,14 +237,13 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, uint64_t view,
         groups += local_groups;
         grouped_hits += local_grouped;
     };
-    // Hits in cell order (Morton order of cells, then the cell, then the slot: a total
-    // order, so the parallel sort is deterministic).
+    // Hits in cell order (then by slot: a total order, so the parallel sort is
+    // deterministic).
     auto sort_items = [&](const std::vector<HitRecord>& hits, const std::vector<uint32_t>& slots) {
         std::vector<SortItem> items(slots.size());
         auto fill = [&](size_t b, size_t e) {
             for (size_t i = b; i < e; ++i) {
-                const Vec3& x = hits[slots[i]].point.position;
-                items[i] = {gatherer.coherence_key(x), gatherer.cell_of(x), slots[i]};
+                items[i] = {gatherer.sort_key(hits[slots[i]].point.position, slots[i]), slots[i]};
             }
         };
         if (items.size() < 4096) {
@@ -325,7 +318,7 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, uint64_t view,
         const size_t chunk = 1024;
         for (size_t i = chunk; i < items.size(); i += chunk) {
             if (s.tile_shared)
-                while (i < items.size() && items[i].cell == items[i - 1].cell) ++i;
+                while (i < items.size() && items[i].same_group(items[i - 1])) ++i;
             if (i >= items.size()) break;
             bounds.push_back(i);
         }

@@ -1,0 +1,714 @@
+#include "techniques/vct/vct_technique.hpp"
+
+#include <atomic>
+#include <cmath>
+#include <sstream>
+#include "core/bsdf.hpp"
+#include "core/error.hpp"
+#include "core/interaction.hpp"
+#include "core/parallel.hpp"
+#include "core/progress.hpp"
+#include "core/rng.hpp"
+#include "core/voxel_grid.hpp"
+
+#ifndef GILAB_GIT_REVISION
+#define GILAB_GIT_REVISION "unknown"
+#endif
+
+namespace gilab {
+
+namespace {
+
+std::string format_number(double v) {
+    std::ostringstream out;
+    out.precision(9);
+    out << v;
+    return out.str();
+}
+
+// One face of a voxel's G-buffer as the lighting passes read it.
+struct FaceInput {
+    float opacity = 0;
+    Vec3 albedo{0}, normal{0}, position{0};
+};
+using VoxelInput = std::array<FaceInput, kFaceCount>;
+using VoxelRadiance = std::array<Vec4, kFaceCount>;
+
+// The Rng of one voxel face, keyed by its world voxel coordinate and level, so a voxel
+// gets the same light samples wherever it is stored and whoever computes it.
+Rng voxel_rng(uint64_t seed, int level, const IVec3& v, int face) {
+    uint64_t key = mix64(uint64_t(uint32_t(v.x)) ^ mix64(uint64_t(uint32_t(v.y)) ^ mix64(uint64_t(uint32_t(v.z)))));
+    return Rng::for_sample(seed, key, uint64_t(level) * 8 + uint64_t(face), 0x766374);
+}
+
+// Faces sharing a normal and position (one flat surface seen from several sides) share
+// their lighting; returns the earlier face or -1.
+int same_as_earlier(const VoxelInput& in, int f) {
+    for (int g = 0; g < f; ++g)
+        if (in[size_t(g)].opacity > 0 && in[size_t(g)].normal == in[size_t(f)].normal &&
+            in[size_t(g)].position == in[size_t(f)].position)
+            return g;
+    return -1;
+}
+
+struct Shading {
+    const RayTracer& tracer;
+    const DirectLighting& lighting;
+    const VctSettings& settings;
+    const ConeSet& injection_set;
+    Bounds3 bounds;  // of the voxelized geometry
+
+    // Direct light leaving each face (premultiplied by its opacity).
+    VoxelRadiance direct(const VoxelInput& in, int level, const IVec3& v, float voxel) const {
+        VoxelRadiance out{};
+        Vec3 E[kFaceCount];
+        for (int f = 0; f < kFaceCount; ++f) {
+            const FaceInput& fi = in[size_t(f)];
+            if (!(fi.opacity > 0)) continue;
+            int g = same_as_earlier(in, f);
+            if (g >= 0) {
+                E[f] = E[g];
+            } else {
+                Rng rng = voxel_rng(settings.seed, level, v, f);
+                float offset = std::max(1e-3f * voxel, 4.0f * ray_epsilon(fi.position));
+                E[f] = lighting.irradiance(tracer, fi.position, fi.normal, offset, rng);
+            }
+            Vec3 L = fi.albedo * kInvPi * E[f];
+            out[size_t(f)] = Vec4(L * fi.opacity, fi.opacity);
+        }
+        return out;
+    }
+
+    // Direct + one bounce gathered by the injection cones from `view` (the direct
+    // V-buffer), premultiplied.
+    VoxelRadiance bounce(const VoxelInput& in, const VoxelRadiance& direct, const VoxelConeView& view, float voxel,
+                         uint64_t& cones) const {
+        VoxelRadiance out{};
+        Vec3 E[kFaceCount];
+        ConeOptions options;
+        options.step = settings.cone_step;
+        options.start = settings.cone_start * voxel;
+        options.ao_lambda = settings.ao_lambda;
+        options.correct_opacity = settings.opacity_correction;
+        options.lod_bias = settings.lod_bias;
+        options.blend_levels = settings.blend_levels;
+        options.bounds = bounds;
+        if (settings.max_distance > 0) options.max_distance = settings.max_distance;
+        for (int f = 0; f < kFaceCount; ++f) {
+            const FaceInput& fi = in[size_t(f)];
+            if (!(fi.opacity > 0)) continue;
+            int g = same_as_earlier(in, f);
+            if (g >= 0) {
+                E[f] = E[g];
+            } else {
+                E[f] = Vec3(0);
+                const Frame frame(fi.normal);
+                ConeOptions o = options;
+                o.clip = settings.clip_plane;
+                o.clip_plane = Vec4(fi.normal, glm::dot(fi.normal, fi.position));
+                for (size_t c = 0; c < injection_set.directions.size(); ++c) {
+                    Cone cone{fi.position + settings.cone_offset * voxel * fi.normal,
+                              frame.to_world(injection_set.directions[c]), injection_set.tan_half_angle};
+                    ConeResult r = trace_cone(view, cone, o);
+                    E[f] += r.radiance * (injection_set.cosines[c] * injection_set.weights[c]);
+                    cones += uint64_t(r.samples) << 32 | 1u;  // samples in the high half
+                }
+            }
+            Vec3 L = Vec3(direct[size_t(f)]) / fi.opacity + fi.albedo * kInvPi * E[f];
+            out[size_t(f)] = Vec4(L * fi.opacity, fi.opacity);
+        }
+        return out;
+    }
+};
+
+VoxelInput input_of(const CascadedVoxelTexture& t, int level, const IVec3& v) {
+    VoxelInput in;
+    for (int f = 0; f < kFaceCount; ++f) {
+        size_t i = t.index_of_voxel(f, level, v);
+        in[size_t(f)] = {t.opacity[i], t.albedo[i], t.normal[i], t.position[i]};
+    }
+    return in;
+}
+
+VoxelInput input_of(const AnisotropicVoxel& voxel) {
+    VoxelInput in;
+    for (int f = 0; f < kFaceCount; ++f) {
+        const VoxelFaceData& d = voxel.faces[size_t(f)];
+        in[size_t(f)] = {d.opacity, d.albedo, d.normal, d.position};
+    }
+    return in;
+}
+
+// Meshes under an animated node (or an animated ancestor) are dynamic.
+std::vector<bool> static_meshes(const Scene& scene, const SceneFrame& frame) {
+    std::vector<bool> animated(scene.nodes.size(), false);
+    for (size_t i = 0; i < scene.nodes.size(); ++i) {
+        const SceneNode& n = scene.nodes[i];
+        animated[i] = !n.animation.empty() || (n.parent >= 0 && animated[size_t(n.parent)]);
+    }
+    std::vector<bool> include(frame.meshes.size(), true);
+    for (size_t m = 0; m < frame.meshes.size(); ++m) {
+        uint32_t node = frame.meshes[m].node;
+        include[m] = !(node < animated.size() && animated[node]);
+    }
+    return include;
+}
+
+Vec3 initial_viewer(const Scene& scene, const Bounds3& bounds) {
+    if (scene.camera) return scene.camera->position;
+    if (scene.hmd) return scene.hmd->pose.position;
+    return bounds.empty() ? Vec3(0) : bounds.center();
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------
+
+VctSettings VctSettings::from(const Settings& s) {
+    VctSettings v;
+    const std::string& where = s.context();
+    auto choose = [&](const std::string& key, const std::string& fallback, std::initializer_list<const char*> options) {
+        std::string value = s.get<std::string>(key, fallback);
+        std::string list;
+        for (const char* o : options) {
+            if (value == o) return value;
+            list += (list.empty() ? "" : ", ") + std::string(o);
+        }
+        throw Error(where, "setting '" + key + "' must be one of " + list + ", got '" + value + "'");
+    };
+    v.structure = choose("structure", "cascaded", {"cascaded", "dense"}) == "dense" ? Structure::Dense : Structure::Cascaded;
+    v.levels = s.get<int>("levels", v.levels);
+    v.resolution = s.get<int>("resolution", v.resolution);
+    v.voxel_size = s.get<double>("voxel_size", v.voxel_size);
+    v.dense_resolution = s.get<int>("dense_resolution", v.dense_resolution);
+    v.diffuse = s.get<bool>("diffuse", v.diffuse);
+    v.diffuse_cones = s.get<int>("diffuse_cones", v.diffuse_cones);
+    v.specular = s.get<bool>("specular", v.specular);
+    v.second_bounce = s.get<bool>("second_bounce", v.second_bounce);
+    v.injection_cones = s.get<int>("injection_cones", v.injection_cones);
+    v.ao_lambda = s.get<float>("ao_lambda", v.ao_lambda);
+    v.cone_step = s.get<float>("cone_step", v.cone_step);
+    v.cone_offset = s.get<float>("cone_offset", v.cone_offset);
+    v.cone_start = s.get<float>("cone_start", v.cone_start);
+    v.opacity_correction = s.get<bool>("opacity_correction", v.opacity_correction);
+    v.lod_bias = s.get<float>("lod_bias", v.lod_bias);
+    v.clip_plane = s.get<bool>("clip_plane", v.clip_plane);
+    v.blend_levels = s.get<bool>("blend_levels", v.blend_levels);
+    v.max_distance = s.get<float>("max_distance", v.max_distance);
+    v.update = choose("update", "strategy", {"strategy", "everything"}) == "everything" ? Update::Everything
+                                                                                       : Update::Strategy;
+    std::string schedule = choose("update_schedule", "log2", {"log2", "pow2", "every"});
+    v.schedule = schedule == "pow2" ? Schedule::Pow2 : schedule == "every" ? Schedule::Every : Schedule::Log2;
+    v.light_samples = s.get<int>("light_samples", v.light_samples);
+    int64_t seed = s.get<int64_t>("seed", int64_t(v.seed));
+    v.tile_size = s.get<int>("tile_size", v.tile_size);
+
+    auto fail = [&](const std::string& key, const std::string& rule, const std::string& got) {
+        throw Error(where, "setting '" + key + "' must be " + rule + ", got " + got);
+    };
+    if (v.levels < 1 || v.levels > 16) fail("levels", "1..16", std::to_string(v.levels));
+    if (v.resolution < 4 || v.resolution > 1024 || (v.resolution & (v.resolution - 1)))
+        fail("resolution", "a power of two in 4..1024", std::to_string(v.resolution));
+    if (!(v.voxel_size >= 0) || !std::isfinite(v.voxel_size))
+        fail("voxel_size", "0 (automatic) or a positive length", format_number(v.voxel_size));
+    if (v.dense_resolution < 2 || v.dense_resolution > 2048 || (v.dense_resolution & (v.dense_resolution - 1)))
+        fail("dense_resolution", "a power of two in 2..2048", std::to_string(v.dense_resolution));
+    if (v.diffuse_cones < 1 || v.diffuse_cones > 256) fail("diffuse_cones", "1..256", std::to_string(v.diffuse_cones));
+    if (v.injection_cones < 1 || v.injection_cones > 256)
+        fail("injection_cones", "1..256", std::to_string(v.injection_cones));
+    if (!(v.ao_lambda >= 0) || !std::isfinite(v.ao_lambda)) fail("ao_lambda", "non-negative", format_number(v.ao_lambda));
+    if (!(v.cone_step > 0.01f) || !(v.cone_step <= 4.0f)) fail("cone_step", "in (0.01, 4]", format_number(v.cone_step));
+    if (!(v.cone_offset >= 0) || !(v.cone_offset <= 16.0f))
+        fail("cone_offset", "in [0, 16] voxels", format_number(v.cone_offset));
+    if (!(v.cone_start >= 0) || !(v.cone_start <= 16.0f))
+        fail("cone_start", "in [0, 16] voxels", format_number(v.cone_start));
+    if (!(v.max_distance >= 0) || !std::isfinite(v.max_distance))
+        fail("max_distance", "0 (unbounded) or positive", format_number(v.max_distance));
+    if (v.light_samples < 1 || v.light_samples > 1024) fail("light_samples", "1..1024", std::to_string(v.light_samples));
+    if (seed < 0) fail("seed", "non-negative", std::to_string(seed));
+    if (v.tile_size < 1) fail("tile_size", "at least 1", std::to_string(v.tile_size));
+    v.seed = uint64_t(seed);
+    return v;
+}
+
+int update_period(VctSettings::Schedule schedule, int level) {
+    const int d = level + 1;
+    switch (schedule) {
+        case VctSettings::Schedule::Every: return 1;
+        case VctSettings::Schedule::Pow2: return 1 << std::min(level, 30);
+        case VctSettings::Schedule::Log2: break;
+    }
+    return std::max(1, int(std::ceil(std::log2(double(d)) - 1e-9)));
+}
+
+// ---------------------------------------------------------------------------------
+
+VctTechnique::VctTechnique() = default;
+VctTechnique::~VctTechnique() = default;
+
+void VctTechnique::prepare(const Scene& scene, const Settings& settings) {
+    Stopwatch watch;
+    settings_ = VctSettings::from(settings);
+    config_hash_ = settings.hash();
+    scene.validate();
+    materials_ = scene.materials;
+    if (scene.is_animated())
+        animated_scene_ = scene;
+    else
+        animated_scene_.reset();
+    tracer_.reset();
+    cascade_.reset();
+    dense_.reset();
+    frame_ = scene.evaluate(0.0);
+    tracer_ = std::make_unique<RayTracer>(frame_);
+    lighting_ = DirectLighting(frame_, materials_, settings_.light_samples);
+    diffuse_set_ = hemisphere_cones(settings_.diffuse_cones);
+    injection_set_ = hemisphere_cones(settings_.injection_cones);
+    stats_ = Stats();
+
+    std::vector<bool> include = static_meshes(scene, frame_);
+    voxelizer_ = AnisotropicVoxelizer(frame_, materials_, include);
+    Bounds3 bounds = voxelizer_.triangle_count() > 0 ? voxelizer_.bounds() : frame_.bounds;
+    const VoxelGrid grid = VoxelGrid::enclosing(bounds, uint32_t(settings_.dense_resolution));
+    const double w0 = settings_.voxel_size > 0 ? settings_.voxel_size : grid.voxel_size();
+
+    Stopwatch voxelize_watch;
+    if (settings_.structure == VctSettings::Structure::Cascaded) {
+        CascadeConfig config;
+        config.levels = settings_.levels;
+        config.resolution = settings_.resolution;
+        config.voxel_size = w0;
+        config.anchor = DVec3(grid.origin);
+        cascade_.emplace(config);
+        const DVec3 viewer(initial_viewer(scene, bounds));
+        for (int k = cascade_->levels() - 1; k >= 0; --k) cascade_->place(k, cascade_->origin_for(viewer, k));
+        for (int k = cascade_->levels() - 1; k >= 0; --k) cascade_->voxelize_own(k, voxelizer_);
+        stats_.set("voxelize_ms", voxelize_watch.elapsed_ms());
+        Stopwatch light_watch;
+        light_cascade(std::vector<bool>(size_t(cascade_->levels()), true));
+        stats_.set("injection_ms", light_watch.elapsed_ms());
+    } else {
+        DenseMipConfig config;
+        config.resolution = settings_.dense_resolution;
+        config.voxel_size = grid.voxel_size();
+        config.anchor = DVec3(grid.origin);
+        dense_.emplace(config);
+        dense_->voxelize(voxelizer_);
+        stats_.set("voxelize_ms", voxelize_watch.elapsed_ms());
+        Stopwatch light_watch;
+        light_dense();
+        stats_.set("injection_ms", light_watch.elapsed_ms());
+    }
+    frame_index_ = 0;
+    stats_.set("prepare_ms", watch.elapsed_ms());
+    stats_.set("triangles", double(frame_.triangle_count()));
+    stats_.set("voxelized_triangles", double(voxelizer_.triangle_count()));
+    stats_.set("base_voxel_size", w0);
+    stats_.set("structure_bytes", double(structure_bytes()));
+}
+
+void VctTechnique::update(double time) {
+    if (!tracer_) throw Error("vct", "update() called before prepare()");
+    if (!animated_scene_) return;
+    Stopwatch watch;
+    frame_ = animated_scene_->evaluate(time);
+    tracer_->update(frame_);
+    lighting_ = DirectLighting(frame_, materials_, settings_.light_samples);
+    stats_.set("scene_update_ms", watch.elapsed_ms());
+}
+
+size_t VctTechnique::structure_bytes() const {
+    if (cascade_) return cascade_->bytes();
+    if (dense_) return dense_->bytes();
+    return 0;
+}
+
+VoxelConeView VctTechnique::radiance_view() const {
+    if (cascade_) return VoxelConeView::cascade(*cascade_, cascade_->radiance);
+    if (dense_) return VoxelConeView::dense(*dense_, dense_->radiance);
+    throw Error("vct", "no voxel structure: prepare() first");
+}
+
+void VctTechnique::light_cascade(const std::vector<bool>& levels) {
+    CascadedVoxelTexture& t = *cascade_;
+    const Shading shading{*tracer_, lighting_, settings_, injection_set_, voxelizer_.bounds()};
+    std::atomic<uint64_t> cones{0}, lit{0};
+    // Voxels a level lights itself: its region minus the part the finer level covers.
+    auto own_voxels = [&](int k) {
+        std::vector<IVec3> own;
+        const VoxelBox inner = t.inner_box(k);
+        for (const IVec3& v : t.occupied_in(k, t.region(k)))
+            if (!inner.contains(v)) own.push_back(v);
+        return own;
+    };
+    auto clear_own = [&](int k, std::vector<Vec4>& buffer) {
+        const VoxelBox box = t.region(k), inner = t.inner_box(k);
+        for (int z = box.begin.z; z < box.end.z; ++z)
+            for (int y = box.begin.y; y < box.end.y; ++y)
+                for (int x = box.begin.x; x < box.end.x; ++x) {
+                    IVec3 v(x, y, z);
+                    if (inner.contains(v)) continue;
+                    for (int f = 0; f < kFaceCount; ++f) buffer[t.index_of_voxel(f, k, v)] = Vec4(0);
+                }
+    };
+    std::vector<std::vector<IVec3>> own(size_t(t.levels()));
+    for (int k = 0; k < t.levels(); ++k)
+        if (levels[size_t(k)]) own[size_t(k)] = own_voxels(k);
+
+    // Direct light, then filtered into the coarser levels.
+    for (int k = 0; k < t.levels(); ++k) {
+        if (!levels[size_t(k)]) continue;
+        clear_own(k, t.direct);
+        const auto& list = own[size_t(k)];
+        const float voxel = float(t.voxel_size(k));
+        parallel_for(list.size(), 16, [&](size_t b, size_t e) {
+            for (size_t i = b; i < e; ++i) {
+                VoxelRadiance r = shading.direct(input_of(t, k, list[i]), k, list[i], voxel);
+                for (int f = 0; f < kFaceCount; ++f) t.direct[t.index_of_voxel(f, k, list[i])] = r[size_t(f)];
+            }
+        });
+        lit += list.size();
+        t.downsample(k, t.direct);
+    }
+    // Voxel bounce from the direct V-buffer.
+    const VoxelConeView view = VoxelConeView::cascade(t, t.direct);
+    for (int k = 0; k < t.levels(); ++k) {
+        if (!levels[size_t(k)]) continue;
+        clear_own(k, t.radiance);
+        const auto& list = own[size_t(k)];
+        const float voxel = float(t.voxel_size(k));
+        parallel_for(list.size(), 4, [&](size_t b, size_t e) {
+            uint64_t local = 0;
+            for (size_t i = b; i < e; ++i) {
+                VoxelRadiance d;
+                for (int f = 0; f < kFaceCount; ++f) d[size_t(f)] = t.direct[t.index_of_voxel(f, k, list[i])];
+                VoxelRadiance r = settings_.second_bounce
+                                      ? shading.bounce(input_of(t, k, list[i]), d, view, voxel, local)
+                                      : d;
+                for (int f = 0; f < kFaceCount; ++f) t.radiance[t.index_of_voxel(f, k, list[i])] = r[size_t(f)];
+            }
+            cones += local;
+        });
+        t.downsample(k, t.radiance);
+    }
+    stats_.add("injection_cones_traced", double(cones.load() & 0xffffffffu));
+    stats_.add("injection_cone_samples", double(cones.load() >> 32));
+    stats_.set("voxels_lit", double(lit.load()));
+}
+
+void VctTechnique::light_dense() {
+    DenseMipTexture& t = *dense_;
+    const Shading shading{*tracer_, lighting_, settings_, injection_set_, voxelizer_.bounds()};
+    const float voxel = float(t.voxel_size(0));
+    const auto& list = t.voxels;
+    DenseMipTexture::clear_level0(t.direct);
+    parallel_for(list.size(), 16, [&](size_t b, size_t e) {
+        for (size_t i = b; i < e; ++i) {
+            VoxelRadiance r = shading.direct(input_of(list[i]), 0, list[i].coord, voxel);
+            for (int f = 0; f < kFaceCount; ++f) t.direct[0][t.index(0, f, list[i].coord)] = r[size_t(f)];
+        }
+    });
+    t.build_mips(t.direct);
+    const VoxelConeView view = VoxelConeView::dense(t, t.direct);
+    std::atomic<uint64_t> cones{0};
+    DenseMipTexture::clear_level0(t.radiance);
+    parallel_for(list.size(), 4, [&](size_t b, size_t e) {
+        uint64_t local = 0;
+        for (size_t i = b; i < e; ++i) {
+            VoxelRadiance d;
+            for (int f = 0; f < kFaceCount; ++f) d[size_t(f)] = t.direct[0][t.index(0, f, list[i].coord)];
+            VoxelRadiance r = settings_.second_bounce ? shading.bounce(input_of(list[i]), d, view, voxel, local) : d;
+            for (int f = 0; f < kFaceCount; ++f) t.radiance[0][t.index(0, f, list[i].coord)] = r[size_t(f)];
+        }
+        cones += local;
+    });
+    t.build_mips(t.radiance);
+    stats_.add("injection_cones_traced", double(cones.load() & 0xffffffffu));
+    stats_.add("injection_cone_samples", double(cones.load() >> 32));
+    stats_.set("voxels_lit", double(list.size()));
+}
+
+void VctTechnique::update_voxels(const Vec3& viewer) {
+    if (!tracer_) throw Error("vct", "render() called before prepare()");
+    ++frame_index_;
+    Stopwatch update_watch;
+    uint64_t revoxelized = 0, clips = 0;
+    int updated_levels = 0;
+    std::vector<bool> scheduled;
+    if (cascade_) {
+        CascadedVoxelTexture& t = *cascade_;
+        scheduled.assign(size_t(t.levels()), false);
+        const DVec3 p(viewer);
+        // Coarse levels first: a scrolling level fills its new border from the next
+        // coarser one, which should already have moved.
+        std::vector<std::vector<VoxelBox>> exposed(size_t(t.levels()));
+        for (int k = t.levels() - 1; k >= 0; --k) {
+            const IVec3 target = t.origin_for(p, k);
+            const IVec3 shift = glm::abs(target - t.origin(k));
+            if (settings_.update == VctSettings::Update::Everything) {
+                t.place(k, target);
+                scheduled[size_t(k)] = true;
+                continue;
+            }
+            // A level that fell a quarter of its width behind is updated at once, so the
+            // finer level never leaves it.
+            const bool due = frame_index_ % update_period(settings_.schedule, k) == 0;
+            const bool forced = std::max(shift.x, std::max(shift.y, shift.z)) > t.resolution() / 4;
+            if (!due && !forced) continue;
+            scheduled[size_t(k)] = true;
+            if (target != t.origin(k)) exposed[size_t(k)] = t.scroll(k, target);
+        }
+        // Every level re-voxelized in full, or only its new border slabs and the band its
+        // finer level uncovered — one pass over the triangles per level.
+        for (int k = t.levels() - 1; k >= 0; --k) {
+            FragmentVoxelizeStats s = settings_.update == VctSettings::Update::Everything
+                                          ? t.voxelize_own(k, voxelizer_)
+                                          : t.follow_inner(k, voxelizer_, exposed[size_t(k)]);
+            revoxelized += s.voxels;
+            clips += s.clips;
+        }
+        for (bool s : scheduled) updated_levels += s;
+    } else if (dense_) {
+        if (settings_.update == VctSettings::Update::Everything) {
+            FragmentVoxelizeStats s = dense_->voxelize(voxelizer_);
+            revoxelized = s.voxels;
+            clips = s.clips;
+        }
+        updated_levels = 1;
+    }
+    stats_.set("update_ms", update_watch.elapsed_ms());
+    stats_.set("levels_updated", double(updated_levels));
+    stats_.set("voxels_revoxelized", double(revoxelized));
+    stats_.set("voxelize_clips", double(clips));
+
+    Stopwatch light_watch;
+    stats_.set("injection_cones_traced", 0);
+    stats_.set("injection_cone_samples", 0);
+    if (cascade_)
+        light_cascade(scheduled);
+    else if (dense_)
+        light_dense();
+    stats_.set("injection_ms", light_watch.elapsed_ms());
+    stats_.set("frame", double(frame_index_));
+}
+
+// ---------------------------------------------------------------------------------
+
+namespace {
+
+struct PixelHit {
+    bool hit = false;
+    bool emissive_front = false;
+    Vec3 position{0}, normal{0}, geometric_normal{0}, wo{0};
+    uint32_t material = 0;
+    float depth = 0;
+};
+
+}  // namespace
+
+void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
+    if (!tracer_) throw Error("vct", "render() called before prepare()");
+    if (views.views.empty()) throw Error("vct", "render() needs at least one view");
+    Stopwatch total_watch;
+    Vec3 viewer(0);
+    for (const EyeCamera& c : views.views) viewer += c.position();
+    viewer /= float(views.views.size());
+    update_voxels(viewer);
+
+    const VoxelConeView view = radiance_view();
+    const float w0 = view.base_voxel_size();
+    ConeOptions options;
+    options.step = settings_.cone_step;
+    options.ao_lambda = settings_.ao_lambda;
+    options.correct_opacity = settings_.opacity_correction;
+    options.lod_bias = settings_.lod_bias;
+    options.blend_levels = settings_.blend_levels;
+    options.bounds = voxelizer_.bounds();
+    if (settings_.max_distance > 0) options.max_distance = settings_.max_distance;
+    // Voxel size at a surface point: cones start a few of them away from their apex.
+    auto voxel_at = [&](const Vec3& p) {
+        int k = view.finest_level_containing(p, 1.0f);
+        return k < 0 ? w0 : view.level(k).voxel_size;
+    };
+
+    double primary_ms = 0, direct_ms = 0, diffuse_ms = 0, specular_ms = 0;
+    std::atomic<uint64_t> cones{0};
+    films.resize(views.views.size());
+    for (size_t vi = 0; vi < views.views.size(); ++vi) {
+        const EyeCamera& camera = views.views[vi];
+        const int width = camera.width(), height = camera.height();
+        check_resolution(width, height, 10);
+        Film film(width, height);
+        for (const char* name : {"direct", "indirect", "specular", "albedo", "normal"}) film.add_layer(name);
+        film.add_layer("ao", 1);
+        film.add_layer("depth", 1);
+        const size_t pixels = film.pixel_count();
+        std::vector<PixelHit> hits(pixels);
+        const int ts = settings_.tile_size;
+
+        Stopwatch watch;
+        parallel_for_tiles(width, height, ts, [&](const Tile& tile) {
+            for (int y = tile.y0; y < tile.y1; ++y)
+                for (int x = tile.x0; x < tile.x1; ++x) {
+                    Ray ray = camera.generate_ray(float(x) + 0.5f, float(y) + 0.5f);
+                    Hit hit = tracer_->intersect(ray);
+                    PixelHit& ph = hits[size_t(y) * size_t(width) + size_t(x)];
+                    if (!hit.valid()) continue;
+                    SurfaceInteraction si = make_interaction(frame_, ray, hit);
+                    ph.hit = true;
+                    ph.position = si.position;
+                    ph.normal = si.shading_normal;
+                    ph.geometric_normal = si.geometric_normal;
+                    ph.wo = si.wo;
+                    ph.material = si.material;
+                    ph.depth = hit.t * glm::length(ray.direction);
+                    ph.emissive_front = materials_[si.material].is_emissive() && !si.back_face;
+                }
+        });
+        primary_ms += watch.elapsed_ms();
+
+        Layer& color = film.layer("color");
+        Layer& direct = film.layer("direct");
+        Layer& indirect = film.layer("indirect");
+        Layer& specular = film.layer("specular");
+        Layer& albedo = film.layer("albedo");
+        Layer& normal = film.layer("normal");
+        Layer& ao = film.layer("ao");
+        Layer& depth = film.layer("depth");
+        auto put = [](Layer& l, size_t i, const Vec3& v) {
+            for (int k = 0; k < 3; ++k) l.data[3 * i + size_t(k)] = v[k];
+        };
+
+        watch.reset();
+        parallel_for_tiles(width, height, ts, [&](const Tile& tile) {
+            for (int y = tile.y0; y < tile.y1; ++y)
+                for (int x = tile.x0; x < tile.x1; ++x) {
+                    const size_t i = size_t(y) * size_t(width) + size_t(x);
+                    const PixelHit& ph = hits[i];
+                    ao.data[i] = 1.0f;
+                    if (!ph.hit) continue;
+                    const Material& m = materials_[ph.material];
+                    Rng rng = Rng::for_sample(settings_.seed, i, 0, vi);
+                    Vec3 L = lighting_.reflected(*tracer_, m, ph.position, ph.normal, ph.geometric_normal, ph.wo,
+                                                 4.0f * ray_epsilon(ph.position), rng);
+                    if (ph.emissive_front) L += m.emission;
+                    put(direct, i, L);
+                    put(albedo, i, m.albedo + m.specular);
+                    put(normal, i, ph.normal);
+                    depth.data[i] = ph.depth;
+                }
+        });
+        direct_ms += watch.elapsed_ms();
+
+        watch.reset();
+        if (settings_.diffuse) {
+            Progress progress("vct " + (vi < views.names.size() ? views.names[vi] : std::string("mono")),
+                              size_t((width + ts - 1) / ts) * size_t((height + ts - 1) / ts));
+            parallel_for_tiles(width, height, ts, [&](const Tile& tile) {
+                uint64_t local = 0;
+                for (int y = tile.y0; y < tile.y1; ++y)
+                    for (int x = tile.x0; x < tile.x1; ++x) {
+                        const size_t i = size_t(y) * size_t(width) + size_t(x);
+                        const PixelHit& ph = hits[i];
+                        if (!ph.hit) continue;
+                        const Material& m = materials_[ph.material];
+                        ConeOptions o = options;
+                        const float w = voxel_at(ph.position);
+                        o.start = settings_.cone_start * w;
+                        const Vec3 apex = ph.position + settings_.cone_offset * w * ph.normal;
+                        o.clip = settings_.clip_plane;
+                        o.clip_plane = Vec4(ph.normal, glm::dot(ph.normal, ph.position));
+                        const Frame frame(ph.normal);
+                        Vec3 E(0);
+                        float occlusion = 0;
+                        for (size_t c = 0; c < diffuse_set_.directions.size(); ++c) {
+                            Cone cone{apex, frame.to_world(diffuse_set_.directions[c]),
+                                      diffuse_set_.tan_half_angle};
+                            ConeResult r = trace_cone(view, cone, o);
+                            const float w = diffuse_set_.cosines[c] * diffuse_set_.weights[c];
+                            E += r.radiance * w;
+                            occlusion += r.occlusion * w;
+                            ++local;
+                        }
+                        put(indirect, i, m.albedo * kInvPi * E);
+                        ao.data[i] = std::clamp(1.0f - occlusion * kInvPi, 0.0f, 1.0f);
+                    }
+                cones += local;
+                progress.advance();
+            });
+            progress.finish();
+        }
+        diffuse_ms += watch.elapsed_ms();
+
+        watch.reset();
+        if (settings_.specular) {
+            parallel_for_tiles(width, height, ts, [&](const Tile& tile) {
+                uint64_t local = 0;
+                for (int y = tile.y0; y < tile.y1; ++y)
+                    for (int x = tile.x0; x < tile.x1; ++x) {
+                        const size_t i = size_t(y) * size_t(width) + size_t(x);
+                        const PixelHit& ph = hits[i];
+                        if (!ph.hit) continue;
+                        const Material& m = materials_[ph.material];
+                        if (!m.has_glossy_lobe()) continue;
+                        const Vec3 r = glm::reflect(-ph.wo, ph.normal);
+                        const float cos_r = glm::dot(r, ph.normal);
+                        if (cos_r <= 0.0f) continue;
+                        ConeOptions o = options;
+                        const float w = voxel_at(ph.position);
+                        o.start = settings_.cone_start * w;
+                        const Vec3 apex = ph.position + settings_.cone_offset * w * ph.normal;
+                        o.clip = settings_.clip_plane;
+                        o.clip_plane = Vec4(ph.normal, glm::dot(ph.normal, ph.position));
+                        ConeResult c = trace_cone(view, Cone{apex, r, phong_cone_tan(m.phong_exponent)}, o);
+                        put(specular, i, m.specular * c.radiance * cos_r);
+                        ++local;
+                    }
+                cones += local;
+            });
+        }
+        specular_ms += watch.elapsed_ms();
+
+        for (size_t i = 0; i < pixels; ++i)
+            for (int k = 0; k < 3; ++k) {
+                size_t j = 3 * i + size_t(k);
+                color.data[j] = direct.data[j] + indirect.data[j] + specular.data[j];
+            }
+
+        film.metadata["technique"] = "vct";
+        film.metadata["structure"] = settings_.structure == VctSettings::Structure::Dense ? "dense" : "cascaded";
+        film.metadata["view"] = vi < views.names.size() ? views.names[vi] : "mono";
+        film.metadata["seed"] = std::to_string(settings_.seed);
+        film.metadata["frame"] = std::to_string(frame_index_);
+        film.metadata["config_hash"] = config_hash_;
+        film.metadata["git_revision"] = GILAB_GIT_REVISION;
+        films[vi] = std::move(film);
+    }
+    const double update_ms = stats_.get("update_ms"), injection_ms = stats_.get("injection_ms");
+    stats_.set("primary_ms", primary_ms);
+    stats_.set("direct_ms", direct_ms);
+    stats_.set("diffuse_ms", diffuse_ms);
+    stats_.set("specular_ms", specular_ms);
+    stats_.set("total_ms", update_ms + injection_ms + primary_ms + direct_ms + diffuse_ms + specular_ms);
+    stats_.set("pixel_cones_traced", double(cones.load()));
+    stats_.set("structure_bytes", double(structure_bytes()));
+    if (cascade_) {
+        size_t occupied = 0;
+        for (int k = 0; k < cascade_->levels(); ++k) occupied += cascade_->occupied_voxels(k);
+        stats_.set("occupied_voxels", double(occupied));
+    } else if (dense_) {
+        stats_.set("occupied_voxels", double(dense_->voxels.size()));
+    }
+    const double ms = total_watch.elapsed_ms();
+    stats_.set("render_ms", ms);
+    for (Film& film : films) film.metadata["render_time_seconds"] = format_number(ms / 1000.0);
+}
+
+void register_vct(TechniqueRegistry& registry) {
+    registry.add({"vct",
+                  "voxel cone tracing on cascaded anisotropic voxel textures (P3); structure=dense gives the "
+                  "mip-mapped 3D texture baseline",
+                  [] { return std::make_unique<VctTechnique>(); }});
+}
+
+}  // namespace gilab

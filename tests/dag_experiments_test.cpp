@@ -1,0 +1,182 @@
+// The P2 (sparse voxel DAG) experiments in quick mode: each writes its files, and the
+// figures hold together (the DAG never has more nodes than the SVO, every structure
+// sees the same voxels, the split build gives the same DAG as the whole conversion,
+// the three traversals agree).
+#include <gtest/gtest.h>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include "experiments/experiment.hpp"
+#include "tests/test_support.hpp"
+
+namespace {
+
+using namespace gilab;
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+const ExperimentRegistry& dag_registry() {
+    static const ExperimentRegistry registry = [] {
+        ExperimentRegistry r;
+        register_dag_experiments(r);
+        return r;
+    }();
+    return registry;
+}
+
+double num(const json& row, const std::string& column) {
+    EXPECT_TRUE(row.contains(column)) << "missing column " << column << " in " << row.dump();
+    return row.contains(column) ? row.at(column).get<double>() : 0.0;
+}
+
+class DagExperimentsTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        if (!test::shared_asset("bunny/stanford-bunny.obj"))
+            GTEST_SKIP() << "bunny/stanford-bunny.obj not found in the shared scenes (set GILAB_ASSETS)";
+    }
+
+    // Runs one experiment's quick mode into a fresh directory and checks the files.
+    ExperimentOutput run_quick(const std::string& name, fs::path* dir_out = nullptr) {
+        ExperimentContext ctx;
+        ctx.quick = true;
+        ctx.output_dir = test::temp_dir("dag_experiments_" + name);
+        ctx.assets = AssetPaths::from_environment();
+        ExperimentOutput out = run_and_write(dag_registry().get(name), ctx);
+        for (const char* file : {"results.csv", "results.json", "table.md"})
+            EXPECT_TRUE(fs::exists(ctx.output_dir / file)) << name << ": " << file << " not written";
+        for (const std::string& file : out.files)
+            EXPECT_GT(fs::file_size(ctx.output_dir / file), 0u) << name << ": " << file << " missing or empty";
+        std::ifstream in(ctx.output_dir / "results.json");
+        json doc = json::parse(in);
+        EXPECT_EQ(doc["experiment"], name);
+        EXPECT_EQ(doc["paper"], "P2");
+        EXPECT_TRUE(doc["quick"].get<bool>());
+        EXPECT_FALSE(doc["config"].empty());
+        EXPECT_FALSE(out.tables.empty());
+        EXPECT_FALSE(out.tables.front().rows.empty()) << name << " produced no rows";
+        // Every row of the first table is in the CSV (header + rows).
+        std::ifstream csv(ctx.output_dir / "results.csv");
+        size_t lines = 0;
+        for (std::string line; std::getline(csv, line);) ++lines;
+        EXPECT_EQ(lines, out.tables.front().rows.size() + 1);
+        if (dir_out) *dir_out = ctx.output_dir;
+        return out;
+    }
+};
+
+TEST(DagExperimentsRegistry, AllFourRegisteredUnderP2) {
+    for (const char* name : {"dag-table1", "dag-table2", "dag-table3", "dag-fig13"}) {
+        const Experiment* e = dag_registry().find(name);
+        ASSERT_NE(e, nullptr) << name;
+        EXPECT_EQ(e->paper, "P2");
+        EXPECT_FALSE(e->description.empty());
+    }
+}
+
+TEST(DagExperimentsRegistry, MissingAssetsSkipRowsWithANote) {
+    ExperimentContext ctx;
+    ctx.quick = true;
+    ctx.output_dir = test::temp_dir("dag_experiments_missing");
+    ctx.assets = AssetPaths({ctx.output_dir / "no-such-assets"});
+    ExperimentOutput out = run_and_write(dag_registry().get("dag-table1"), ctx);
+    ASSERT_FALSE(out.tables.empty());
+    EXPECT_TRUE(out.tables.front().rows.empty());
+    bool named = false;
+    for (const std::string& note : out.notes) named |= note.find("stanford-bunny.obj") != std::string::npos;
+    EXPECT_TRUE(named) << "no note names the missing bunny mesh";
+    EXPECT_TRUE(fs::exists(ctx.output_dir / "results.json"));
+}
+
+TEST_F(DagExperimentsTest, Table1CountsAreConsistent) {
+    ExperimentOutput out = run_quick("dag-table1");
+    ASSERT_EQ(out.tables.size(), 2u);
+    bool bunny = false;
+    for (const json& row : out.tables[0].rows) {
+        bunny |= row["scene"] == "Bunny";
+        const double voxels = num(row, "voxels"), svo = num(row, "svo_nodes"), dag = num(row, "svdag_nodes");
+        EXPECT_GT(voxels, 0);
+        EXPECT_GT(svo, voxels);  // leaves plus at least the root
+        EXPECT_LE(dag, svo);
+        EXPECT_LT(num(row, "esvo_nodes"), svo);  // leaves have no descriptor
+        EXPECT_EQ(num(row, "svo_pointers"), svo - voxels);  // one per node with children
+        EXPECT_NEAR(num(row, "svo_over_svdag_nodes"), svo / dag, 1e-9 * svo);
+        EXPECT_GT(num(row, "paper_svo_nodes"), 0);  // reference data present for the paper's models
+    }
+    EXPECT_TRUE(bunny);
+    for (const json& row : out.tables[1].rows) {
+        const double voxels = num(row, "voxels");
+        for (const char* c : {"svo_voxels", "esvo_voxels", "svdag_voxels", "openvdb_voxels", "octomap_voxels"})
+            EXPECT_EQ(num(row, c), voxels) << row["scene"] << " " << c;
+        EXPECT_TRUE(row["voxel_counts_agree"].get<bool>());
+        EXPECT_GT(num(row, "openvdb_leaf_nodes"), 0);
+        EXPECT_GT(num(row, "openvdb_internal_nodes"), 0);
+        EXPECT_GE(num(row, "octomap_nodes"), voxels);
+        EXPECT_GT(num(row, "octomap_MB"), 0);
+    }
+}
+
+TEST_F(DagExperimentsTest, Table2StorageIsConsistent) {
+    ExperimentOutput out = run_quick("dag-table2");
+    std::map<std::string, double> voxels_at_low;
+    for (const json& row : out.tables[0].rows) {
+        for (const char* c : {"svo_pointerless_MB", "svo_stored_MB", "esvo_MB", "svdag_MB", "openvdb_MB", "octomap_MB"})
+            EXPECT_GT(num(row, c), 0) << row["scene"] << " " << c;
+        // Stored SVO = 1 B mask per node + 4 B per node with children, so more than pointerless.
+        EXPECT_GT(num(row, "svo_stored_MB"), num(row, "svo_pointerless_MB"));
+        EXPECT_NEAR(num(row, "svo_over_svdag"), num(row, "svo_pointerless_MB") / num(row, "svdag_MB"), 1e-9);
+        const std::string scene = row["scene"];
+        if (num(row, "resolution") == 64) voxels_at_low[scene] = num(row, "voxels");
+        else EXPECT_GT(num(row, "voxels"), voxels_at_low[scene]) << scene << ": finer grid, more voxels";
+    }
+}
+
+TEST_F(DagExperimentsTest, Table3TimesArePositiveAndSplitMatchesWhole) {
+    ExperimentOutput out = run_quick("dag-table3");
+    std::map<std::pair<std::string, double>, double> whole_nodes;
+    size_t split_rows = 0;
+    for (const json& row : out.tables[0].rows) {
+        const double t_a = num(row, "t_A_ms"), t_b = num(row, "t_B_ms");
+        EXPECT_GT(t_a, 0) << row.dump();
+        EXPECT_GT(t_b, 0) << row.dump();
+        EXPECT_LE(t_b, t_a) << row.dump();
+        EXPECT_GT(num(row, "peak_rss_MiB"), 0);
+        EXPECT_GE(num(row, "peak_rss_MiB"), num(row, "rss_before_MiB"));
+        EXPECT_GE(num(row, "repetitions"), 1);
+        const auto key = std::make_pair(row["scene"].get<std::string>(), num(row, "resolution"));
+        if (num(row, "split_level") == 0) {
+            EXPECT_LE(num(row, "svdag_nodes"), num(row, "svo_nodes"));
+            whole_nodes[key] = num(row, "svdag_nodes");
+        } else {
+            ++split_rows;
+            EXPECT_GT(num(row, "subtrees"), 1);
+            ASSERT_TRUE(whole_nodes.count(key)) << "no whole conversion row before the split row " << row.dump();
+            EXPECT_EQ(num(row, "svdag_nodes"), whole_nodes[key]) << "the minimal DAG is unique";
+        }
+        if (num(row, "resolution") == 128) {
+            EXPECT_GT(num(row, "paper_t_A_ms"), 0);
+        }
+    }
+    EXPECT_GT(split_rows, 0u);
+}
+
+TEST_F(DagExperimentsTest, Fig13TraversalsAgree) {
+    fs::path dir;
+    ExperimentOutput out = run_quick("dag-fig13", &dir);
+    EXPECT_EQ(out.files.size(), out.tables[0].rows.size());  // one depth image per scene
+    EXPECT_TRUE(fs::exists(dir / "depth_bunny.png"));
+    for (const json& row : out.tables[0].rows) {
+        EXPECT_TRUE(row["same_hits_in_all_three"].get<bool>());
+        const double nodes = num(row, "svo_nodes_per_ray");
+        EXPECT_GT(nodes, 0);
+        EXPECT_EQ(num(row, "esvo_nodes_per_ray"), nodes);
+        EXPECT_EQ(num(row, "svdag_nodes_per_ray"), nodes);
+        EXPECT_GT(num(row, "hit_fraction"), 0);
+        EXPECT_LT(num(row, "hit_fraction"), 1);
+        for (const char* c : {"svo_mrays_per_s", "esvo_mrays_per_s", "svdag_mrays_per_s"}) EXPECT_GT(num(row, c), 0);
+        EXPECT_NEAR(num(row, "svdag_over_svo_throughput"), num(row, "svdag_mrays_per_s") / num(row, "svo_mrays_per_s"),
+                    1e-9);
+    }
+}
+
+}  // namespace
