@@ -250,25 +250,17 @@ void VctTechnique::prepare(const Scene& scene, const Settings& settings) {
     Stopwatch watch;
     settings_ = VctSettings::from(settings);
     config_hash_ = settings.hash();
-    scene.validate();
-    materials_ = scene.materials;
-    if (scene.is_animated())
-        animated_scene_ = scene;
-    else
-        animated_scene_.reset();
-    tracer_.reset();
     cascade_.reset();
     dense_.reset();
-    frame_ = scene.evaluate(0.0);
-    tracer_ = std::make_unique<RayTracer>(frame_);
-    lighting_ = DirectLighting(frame_, materials_, settings_.light_samples);
+    scene_.load(scene);
+    lighting_ = DirectLighting(scene_.frame(), scene_.materials(), settings_.light_samples);
     diffuse_set_ = hemisphere_cones(settings_.diffuse_cones);
     injection_set_ = hemisphere_cones(settings_.injection_cones);
     stats_ = Stats();
 
-    std::vector<bool> include = static_meshes(scene, frame_);
-    voxelizer_ = AnisotropicVoxelizer(frame_, materials_, include);
-    Bounds3 bounds = voxelizer_.triangle_count() > 0 ? voxelizer_.bounds() : frame_.bounds;
+    std::vector<bool> include = static_meshes(scene, scene_.frame());
+    voxelizer_ = AnisotropicVoxelizer(scene_.frame(), scene_.materials(), include);
+    Bounds3 bounds = voxelizer_.triangle_count() > 0 ? voxelizer_.bounds() : scene_.frame().bounds;
     const VoxelGrid grid = VoxelGrid::enclosing(bounds, uint32_t(settings_.dense_resolution));
     const double w0 = settings_.voxel_size > 0 ? settings_.voxel_size : grid.voxel_size();
 
@@ -301,19 +293,18 @@ void VctTechnique::prepare(const Scene& scene, const Settings& settings) {
     }
     frame_index_ = 0;
     stats_.set("prepare_ms", watch.elapsed_ms());
-    stats_.set("triangles", double(frame_.triangle_count()));
+    stats_.set("triangles", double(scene_.frame().triangle_count()));
     stats_.set("voxelized_triangles", double(voxelizer_.triangle_count()));
     stats_.set("base_voxel_size", w0);
     stats_.set("structure_bytes", double(structure_bytes()));
 }
 
 void VctTechnique::update(double time) {
-    if (!tracer_) throw Error("vct", "update() called before prepare()");
-    if (!animated_scene_) return;
+    if (!scene_.loaded()) throw Error("vct", "update() called before prepare()");
+    if (!scene_.animated()) return;
     Stopwatch watch;
-    frame_ = animated_scene_->evaluate(time);
-    tracer_->update(frame_);
-    lighting_ = DirectLighting(frame_, materials_, settings_.light_samples);
+    scene_.set_time(time);
+    lighting_ = DirectLighting(scene_.frame(), scene_.materials(), settings_.light_samples);
     stats_.set("scene_update_ms", watch.elapsed_ms());
 }
 
@@ -331,7 +322,7 @@ VoxelConeView VctTechnique::radiance_view() const {
 
 void VctTechnique::light_cascade(const std::vector<bool>& levels) {
     CascadedVoxelTexture& t = *cascade_;
-    const Shading shading{*tracer_, lighting_, settings_, injection_set_, voxelizer_.bounds()};
+    const Shading shading{scene_.tracer(), lighting_, settings_, injection_set_, voxelizer_.bounds()};
     std::atomic<uint64_t> cones{0}, lit{0};
     // Voxels a level lights itself: its region minus the part the finer level covers.
     auto own_voxels = [&](int k) {
@@ -398,7 +389,7 @@ void VctTechnique::light_cascade(const std::vector<bool>& levels) {
 
 void VctTechnique::light_dense() {
     DenseMipTexture& t = *dense_;
-    const Shading shading{*tracer_, lighting_, settings_, injection_set_, voxelizer_.bounds()};
+    const Shading shading{scene_.tracer(), lighting_, settings_, injection_set_, voxelizer_.bounds()};
     const float voxel = float(t.voxel_size(0));
     const auto& list = t.voxels;
     DenseMipTexture::clear_level0(t.direct);
@@ -429,7 +420,7 @@ void VctTechnique::light_dense() {
 }
 
 void VctTechnique::update_voxels(const Vec3& viewer) {
-    if (!tracer_) throw Error("vct", "render() called before prepare()");
+    if (!scene_.loaded()) throw Error("vct", "render() called before prepare()");
     ++frame_index_;
     Stopwatch update_watch;
     uint64_t revoxelized = 0, clips = 0;
@@ -507,7 +498,7 @@ struct PixelHit {
 }  // namespace
 
 void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
-    if (!tracer_) throw Error("vct", "render() called before prepare()");
+    if (!scene_.loaded()) throw Error("vct", "render() called before prepare()");
     if (views.views.empty()) throw Error("vct", "render() needs at least one view");
     Stopwatch total_watch;
     Vec3 viewer(0);
@@ -551,10 +542,10 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
             for (int y = tile.y0; y < tile.y1; ++y)
                 for (int x = tile.x0; x < tile.x1; ++x) {
                     Ray ray = camera.generate_ray(float(x) + 0.5f, float(y) + 0.5f);
-                    Hit hit = tracer_->intersect(ray);
+                    Hit hit = scene_.tracer().intersect(ray);
                     PixelHit& ph = hits[size_t(y) * size_t(width) + size_t(x)];
                     if (!hit.valid()) continue;
-                    SurfaceInteraction si = make_interaction(frame_, ray, hit);
+                    SurfaceInteraction si = make_interaction(scene_.frame(), ray, hit);
                     ph.hit = true;
                     ph.position = si.position;
                     ph.normal = si.shading_normal;
@@ -562,7 +553,7 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
                     ph.wo = si.wo;
                     ph.material = si.material;
                     ph.depth = hit.t * glm::length(ray.direction);
-                    ph.emissive_front = materials_[si.material].is_emissive() && !si.back_face;
+                    ph.emissive_front = scene_.materials()[si.material].is_emissive() && !si.back_face;
                 }
         });
         primary_ms += watch.elapsed_ms();
@@ -587,9 +578,9 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
                     const PixelHit& ph = hits[i];
                     ao.data[i] = 1.0f;
                     if (!ph.hit) continue;
-                    const Material& m = materials_[ph.material];
+                    const Material& m = scene_.materials()[ph.material];
                     Rng rng = Rng::for_sample(settings_.seed, i, 0, vi);
-                    Vec3 L = lighting_.reflected(*tracer_, m, ph.position, ph.normal, ph.geometric_normal, ph.wo,
+                    Vec3 L = lighting_.reflected(scene_.tracer(), m, ph.position, ph.normal, ph.geometric_normal, ph.wo,
                                                  4.0f * ray_epsilon(ph.position), rng);
                     if (ph.emissive_front) L += m.emission;
                     put(direct, i, L);
@@ -611,7 +602,7 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
                         const size_t i = size_t(y) * size_t(width) + size_t(x);
                         const PixelHit& ph = hits[i];
                         if (!ph.hit) continue;
-                        const Material& m = materials_[ph.material];
+                        const Material& m = scene_.materials()[ph.material];
                         ConeOptions o = options;
                         const float w = voxel_at(ph.position);
                         o.start = settings_.cone_start * w;
@@ -649,7 +640,7 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
                         const size_t i = size_t(y) * size_t(width) + size_t(x);
                         const PixelHit& ph = hits[i];
                         if (!ph.hit) continue;
-                        const Material& m = materials_[ph.material];
+                        const Material& m = scene_.materials()[ph.material];
                         if (!m.has_glossy_lobe()) continue;
                         const Vec3 r = glm::reflect(-ph.wo, ph.normal);
                         const float cos_r = glm::dot(r, ph.normal);

@@ -46,6 +46,7 @@
 #include "accel/cascaded_voxel_texture.hpp"
 #include "accel/dense_mip_texture.hpp"
 #include "core/ray_tracer.hpp"
+#include "core/traced_scene.hpp"
 #include "techniques/technique.hpp"
 #include "techniques/vct/cone_tracer.hpp"
 #include "techniques/vct/direct_lighting.hpp"
@@ -118,10 +119,7 @@ private:
 
     VctSettings settings_;
     std::string config_hash_;
-    std::optional<Scene> animated_scene_;
-    std::vector<Material> materials_;
-    SceneFrame frame_;
-    std::unique_ptr<RayTracer> tracer_;
+    TracedScene scene_;
     DirectLighting lighting_;
     AnisotropicVoxelizer voxelizer_;
     std::optional<CascadedVoxelTexture> cascade_;
