@@ -108,21 +108,12 @@ void PhotonMappingTechnique::prepare(const Scene& scene, const Settings& setting
     Stopwatch watch;
     settings_ = PhotonMappingSettings::from(settings);
     config_hash_ = settings.hash();
-    scene.validate();
-    materials_ = scene.materials;
-    if (scene.is_animated())
-        animated_scene_ = scene;
-    else
-        animated_scene_.reset();
-    tracer_.reset();
-    frame_ = scene.evaluate(0.0);
-    tracer_ = std::make_unique<RayTracer>(frame_);
-    lights_ = LightSampler(frame_, materials_);
+    scene_.load(scene);
     stats_ = Stats();
     trace_and_build();
     stats_.set("prepare_ms", watch.elapsed_ms());
-    stats_.set("triangles", double(frame_.triangle_count()));
-    stats_.set("lights", double(lights_.light_count()));
+    stats_.set("triangles", double(scene_.frame().triangle_count()));
+    stats_.set("lights", double(scene_.lights().light_count()));
 }
 
 void PhotonMappingTechnique::trace_and_build() {
@@ -131,7 +122,7 @@ void PhotonMappingTechnique::trace_and_build() {
     ts.max_depth = settings_.max_photon_depth;
     ts.first_stored_hit = 2;
     ts.seed = settings_.seed;
-    PhotonTraceResult traced = trace_photons(*tracer_, frame_, materials_, lights_, ts);
+    PhotonTraceResult traced = trace_photons(scene_.tracer(), scene_.frame(), scene_.materials(), scene_.lights(), ts);
     const size_t stored = traced.photons.size();
     Stopwatch build;
     auto map = make_photon_map(settings_.photon_map);
@@ -148,22 +139,19 @@ void PhotonMappingTechnique::trace_and_build() {
 }
 
 void PhotonMappingTechnique::update(double time) {
-    if (!tracer_) throw Error("photon", "update() called before prepare()");
-    if (!animated_scene_) return;
+    if (!scene_.loaded()) throw Error("photon", "update() called before prepare()");
+    if (!scene_.animated()) return;
     Stopwatch watch;
-    frame_ = animated_scene_->evaluate(time);
-    RayTracer::UpdateKind kind = tracer_->update(frame_);
-    lights_ = LightSampler(frame_, materials_);
-    trace_and_build();
+    scene_.set_time(time, &stats_);
+    trace_and_build();  // photons follow the moved geometry and lights
     stats_.set("update_ms", watch.elapsed_ms());
-    stats_.set("bvh_rebuilt", kind == RayTracer::UpdateKind::Rebuild ? 1.0 : 0.0);
 }
 
 void PhotonMappingTechnique::render_view(const EyeCamera& camera, uint64_t view, Film& film,
                                          PhotonQueryStats& query_stats, Stats& frame_stats) const {
     const int width = camera.width(), height = camera.height();
     const PhotonMappingSettings& s = settings_;
-    const PhotonGatherer gatherer(*map_, materials_, s.gather, s.radius, size_t(s.k));
+    const PhotonGatherer gatherer(*map_, scene_.materials(), s.gather, s.radius, size_t(s.k));
     float* direct = film.layer("direct").data.data();
     float* indirect = film.layer("indirect").data.data();
     std::mutex merge;
@@ -175,19 +163,19 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, uint64_t view,
         rec.pixel = uint32_t(size_t(y) * size_t(width) + size_t(x));
         Vec3 L(0.0f);
         Ray ray = camera.generate_ray(float(x) + 0.5f, float(y) + 0.5f);
-        Hit hit = tracer_->intersect(ray);
+        Hit hit = scene_.tracer().intersect(ray);
         if (hit.valid()) {
-            SurfaceInteraction si = make_interaction(frame_, ray, hit);
-            const Material& m = materials_[si.material];
+            SurfaceInteraction si = make_interaction(scene_.frame(), ray, hit);
+            const Material& m = scene_.materials()[si.material];
             if (m.is_emissive() && !si.back_face) L += m.emission;
-            if (s.light_samples > 0 && !lights_.empty()) {
+            if (s.light_samples > 0 && !scene_.lights().empty()) {
                 Rng rng = Rng::for_sample(s.seed, rec.pixel, 0, view);
                 Vec3 sum(0.0f);
                 for (int k = 0; k < s.light_samples; ++k) {
-                    LightSample ls = lights_.sample_incident(si.position, rng);
+                    LightSample ls = scene_.lights().sample_incident(si.position, rng);
                     if (!(ls.pdf > 0.0f) || is_black(ls.Li) || glm::dot(ls.wi, si.geometric_normal) <= 0.0f) continue;
                     Vec3 f = bsdf_eval(m, si.shading_normal, si.wo, ls.wi);
-                    if (is_black(f) || tracer_->occluded(shadow_ray(si, ls))) continue;
+                    if (is_black(f) || scene_.tracer().occluded(shadow_ray(si, ls))) continue;
                     sum += f * ls.Li * (glm::dot(si.shading_normal, ls.wi) / ls.pdf);
                 }
                 L += sum / float(s.light_samples);
@@ -344,7 +332,7 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, uint64_t view,
 }
 
 void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& films) {
-    if (!tracer_ || !map_) throw Error("photon", "render() called before prepare()");
+    if (!scene_.loaded() || !map_) throw Error("photon", "render() called before prepare()");
     Stopwatch watch;
     films.resize(views.views.size());
     PhotonQueryStats queries;

@@ -26,6 +26,7 @@
 #include "core/light_sampler.hpp"
 #include "core/ray_tracer.hpp"
 #include "techniques/photon_mapping/photon_gather.hpp"
+#include "core/traced_scene.hpp"
 #include "techniques/technique.hpp"
 
 namespace gilab {
@@ -67,11 +68,7 @@ private:
 
     PhotonMappingSettings settings_;
     std::string config_hash_;
-    std::optional<Scene> animated_scene_;
-    std::vector<Material> materials_;
-    SceneFrame frame_;
-    std::unique_ptr<RayTracer> tracer_;
-    LightSampler lights_;
+    TracedScene scene_;
     std::unique_ptr<PhotonMap> map_;
     Stats stats_;
 };
