@@ -11,4 +11,11 @@ const char* to_string(LightType type) {
     return "unknown";
 }
 
+float spot_falloff(const PunctualLight& l, float cos_theta) {
+    if (cos_theta >= l.cos_inner) return 1.0f;
+    if (cos_theta <= l.cos_outer) return 0.0f;
+    float t = (cos_theta - l.cos_outer) / (l.cos_inner - l.cos_outer);
+    return t * t * (3.0f - 2.0f * t);
+}
+
 }  // namespace gilab

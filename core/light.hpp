@@ -23,4 +23,9 @@ struct PunctualLight {
 
 const char* to_string(LightType type);
 
+// Spot falloff: 1 inside cos_inner, 0 outside cos_outer, smoothstep in cosθ between.
+// The smoothstep integrates to 1/2 over its interval, so the cone's power is exactly
+// 2π(1 − (cos_inner + cos_outer)/2)·I.
+float spot_falloff(const PunctualLight& light, float cos_theta);
+
 }  // namespace gilab

@@ -10,16 +10,6 @@ namespace {
 
 float channel_average(const Vec3& c) { return (c.x + c.y + c.z) / 3.0f; }
 
-// Spot falloff: 1 inside cos_inner, 0 outside cos_outer, smoothstep in cosθ between.
-// The smoothstep integrates to 1/2 over its interval, so the cone's power is exactly
-// 2π(1 − (cos_inner + cos_outer)/2)·I.
-float spot_falloff(const PunctualLight& l, float cos_theta) {
-    if (cos_theta >= l.cos_inner) return 1.0f;
-    if (cos_theta <= l.cos_outer) return 0.0f;
-    float t = (cos_theta - l.cos_outer) / (l.cos_inner - l.cos_outer);
-    return t * t * (3.0f - 2.0f * t);
-}
-
 Vec3 unit_or(const Vec3& v, const Vec3& fallback) {
     float len = glm::length(v);
     return len > 0.0f && std::isfinite(len) ? v / len : fallback;
@@ -203,6 +193,20 @@ EmissionSample LightSampler::sample_emission(Rng& rng) const {
         }
     }
     return s;
+}
+
+Ray shadow_ray(const SurfaceInteraction& si, const LightSample& ls) {
+    Ray r;
+    r.origin = si.spawn_origin(ls.wi);
+    r.direction = ls.wi;
+    if (std::isinf(ls.distance)) return r;
+    Vec3 target = si.position + ls.distance * ls.wi;
+    Vec3 d = target - r.origin;
+    float dist = glm::length(d);
+    if (!(dist > 0.0f)) return r;
+    r.direction = d / dist;
+    r.tmax = std::max(0.0f, dist - ray_epsilon(target));
+    return r;
 }
 
 }  // namespace gilab

@@ -2,6 +2,7 @@
 // All lights of a scene frame (emissive triangles and punctual lights) in one
 // distribution proportional to emitted power.
 #include <vector>
+#include "core/interaction.hpp"
 #include "core/rng.hpp"
 #include "core/sampling.hpp"
 #include "core/scene.hpp"
@@ -65,5 +66,10 @@ private:
     Vec3 scene_center_{0};
     float scene_radius_ = 1;
 };
+
+// The shadow ray for a light sample seen from a surface, stopping just short of the
+// light. It is aimed from the offset origin at the sample point itself: a ray parallel
+// to wi would be shifted off the light point and could hit the emitter's own plane.
+Ray shadow_ray(const SurfaceInteraction& si, const LightSample& sample);
 
 }  // namespace gilab

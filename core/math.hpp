@@ -24,6 +24,7 @@ inline constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
 inline float max_component(const Vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
 inline float luminance(const Vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+inline bool is_black(const Vec3& v) { return v.x <= 0.0f && v.y <= 0.0f && v.z <= 0.0f; }
 inline bool is_finite(const Vec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }

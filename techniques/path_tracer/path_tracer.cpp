@@ -31,25 +31,6 @@ void add_light(PathSample& s, int bounces, const Vec3& value) {
     (bounces <= 1 ? s.direct : s.indirect) += value;
 }
 
-bool is_black(const Vec3& v) { return v.x <= 0.0f && v.y <= 0.0f && v.z <= 0.0f; }
-
-// A shadow ray from a surface towards a light sample, stopping just short of it. It is
-// aimed from the offset origin at the sample point itself: a ray parallel to wi would be
-// shifted off the light point and could hit the emitter's own plane before tmax.
-Ray shadow_ray(const SurfaceInteraction& si, const LightSample& ls) {
-    Ray r;
-    r.origin = si.spawn_origin(ls.wi);
-    r.direction = ls.wi;
-    if (std::isinf(ls.distance)) return r;
-    Vec3 target = si.position + ls.distance * ls.wi;
-    Vec3 d = target - r.origin;
-    float dist = glm::length(d);
-    if (!(dist > 0.0f)) return r;
-    r.direction = d / dist;
-    r.tmax = std::max(0.0f, dist - ray_epsilon(target));
-    return r;
-}
-
 std::string format_number(double v) {
     std::ostringstream out;
     out.precision(9);

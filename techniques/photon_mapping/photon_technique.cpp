@@ -29,18 +29,6 @@ std::string number(double v) {
     return out.str();
 }
 
-bool is_black(const Vec3& v) { return v.x <= 0.0f && v.y <= 0.0f && v.z <= 0.0f; }
-
-Ray shadow_ray(const SurfaceInteraction& si, const LightSample& ls) {
-    Ray r;
-    r.origin = si.spawn_origin(ls.wi);
-    r.direction = ls.wi;
-    if (std::isinf(ls.distance)) return r;
-    Vec3 target = si.position + ls.distance * ls.wi;
-    r.tmax = std::max(0.0f, glm::length(target - r.origin) - ray_epsilon(target));
-    return r;
-}
-
 // A primary hit waiting for its gather.
 struct HitRecord {
     GatherPoint point;

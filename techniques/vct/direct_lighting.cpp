@@ -8,14 +8,6 @@ namespace gilab {
 
 namespace {
 
-// Same smoothstep falloff as the light sampler, so every technique lights alike.
-float spot_falloff(const PunctualLight& l, float cos_theta) {
-    if (cos_theta >= l.cos_inner) return 1.0f;
-    if (cos_theta <= l.cos_outer) return 0.0f;
-    float t = (cos_theta - l.cos_outer) / (l.cos_inner - l.cos_outer);
-    return t * t * (3.0f - 2.0f * t);
-}
-
 // A shadow ray from `origin` to `target` (a point), stopping just short of it.
 Ray segment(const Vec3& origin, const Vec3& target) {
     Ray r;
