@@ -12,18 +12,10 @@
 
 namespace fs = std::filesystem;
 using namespace gilab;
+using gilab::test::error_of;
+using gilab::test::write_file;
 
 namespace {
-
-template <typename F>
-std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
-}
 
 // Builds a model with one buffer; each add_* appends a buffer view and an accessor.
 struct ModelBuilder {

@@ -10,14 +10,7 @@
 namespace gilab {
 namespace {
 
-std::string error_of(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "<no error>";
-}
+using test::error_of;
 
 std::string write_trace(const std::string& dir_name, const std::string& file,
                         const std::string& text) {

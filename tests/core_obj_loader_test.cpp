@@ -9,25 +9,10 @@
 
 namespace fs = std::filesystem;
 using namespace gilab;
+using gilab::test::error_of;
+using gilab::test::write_file;
 
 namespace {
-
-fs::path write_file(const fs::path& dir, const std::string& name, const std::string& text) {
-    fs::path p = dir / name;
-    std::ofstream(p, std::ios::binary) << text;
-    return p;
-}
-
-// Message of the Error thrown by f, or "" if none was thrown.
-template <typename F>
-std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
-}
 
 const char* kQuadObj =
     "mtllib quad.mtl\n"

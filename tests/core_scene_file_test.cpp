@@ -10,25 +10,10 @@
 
 namespace fs = std::filesystem;
 using namespace gilab;
+using gilab::test::error_of;
+using gilab::test::write_file;
 
 namespace {
-
-template <typename F>
-std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
-}
-
-fs::path write_file(const fs::path& dir, const std::string& name, const std::string& text) {
-    fs::path p = dir / name;
-    fs::create_directories(p.parent_path());
-    std::ofstream(p, std::ios::binary) << text;
-    return p;
-}
 
 // Two small OBJ files with their own MTLs; "shared" is identical in both.
 fs::path fixture_dir(const std::string& name) {

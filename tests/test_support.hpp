@@ -1,6 +1,7 @@
 #pragma once
 // Shared helpers for tests: where the shared assets are, temp directories.
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -11,5 +12,11 @@ namespace gilab::test {
 std::optional<std::filesystem::path> shared_asset(const std::string& relative);
 // A fresh empty directory under the build tree for this test's outputs.
 std::filesystem::path temp_dir(const std::string& name);
+
+// Writes `text` to dir/name (creating subdirectories) and returns the path.
+std::filesystem::path write_file(const std::filesystem::path& dir, const std::string& name, const std::string& text);
+
+// The message of the gilab::Error that f throws, or "<no error>" if it throws none.
+std::string error_of(const std::function<void()>& f);
 
 }  // namespace gilab::test
