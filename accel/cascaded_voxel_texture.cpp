@@ -283,17 +283,17 @@ FragmentVoxelizeStats CascadedVoxelTexture::follow_inner(int level, const Anisot
     const VoxelBox old_inner = own_inner_[size_t(level)].intersect(region(level));
     const VoxelBox inner = inner_box(level);
     own_inner_[size_t(level)] = inner;
-    std::vector<VoxelBox> todo;
-    for (const VoxelBox& b : exposed) todo.push_back(b.intersect(region(level)));
+    std::vector<VoxelBox> pending;
+    for (const VoxelBox& b : exposed) pending.push_back(b.intersect(region(level)));
     if (!(old_inner.begin == inner.begin && old_inner.end == inner.end)) {
         for (const VoxelBox& part : subtract(inner, old_inner)) clear_gbuffer(level, part);
         for (const VoxelBox& part : subtract(old_inner, inner)) {
             clear_gbuffer(level, part);
-            todo.push_back(part);
+            pending.push_back(part);
         }
     }
-    if (todo.empty()) return stats;
-    voxelizer.voxelize_each(lattice(level), todo, [&](const AnisotropicVoxel& v) { write(level, v); }, &stats, inner);
+    if (pending.empty()) return stats;
+    voxelizer.voxelize_each(lattice(level), pending, [&](const AnisotropicVoxel& v) { write(level, v); }, &stats, inner);
     return stats;
 }
 

@@ -521,6 +521,21 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
         int k = view.finest_level_containing(p, 1.0f);
         return k < 0 ? w0 : view.level(k).voxel_size;
     };
+    // Cones gathered at a visible surface: apex lifted off the surface, first sample a
+    // few voxels out, and (optionally) clipped to the surface's front half-space.
+    struct SurfaceCones {
+        ConeOptions options;
+        Vec3 apex;
+    };
+    auto cones_at = [&](const PixelHit& ph) {
+        SurfaceCones sc{options, Vec3(0)};
+        const float w = voxel_at(ph.position);
+        sc.options.start = settings_.cone_start * w;
+        sc.options.clip = settings_.clip_plane;
+        sc.options.clip_plane = Vec4(ph.normal, glm::dot(ph.normal, ph.position));
+        sc.apex = ph.position + settings_.cone_offset * w * ph.normal;
+        return sc;
+    };
 
     double primary_ms = 0, direct_ms = 0, diffuse_ms = 0, specular_ms = 0;
     std::atomic<uint64_t> cones{0};
@@ -603,19 +618,14 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
                         const PixelHit& ph = hits[i];
                         if (!ph.hit) continue;
                         const Material& m = scene_.materials()[ph.material];
-                        ConeOptions o = options;
-                        const float w = voxel_at(ph.position);
-                        o.start = settings_.cone_start * w;
-                        const Vec3 apex = ph.position + settings_.cone_offset * w * ph.normal;
-                        o.clip = settings_.clip_plane;
-                        o.clip_plane = Vec4(ph.normal, glm::dot(ph.normal, ph.position));
+                        const SurfaceCones sc = cones_at(ph);
                         const Frame frame(ph.normal);
                         Vec3 E(0);
                         float occlusion = 0;
                         for (size_t c = 0; c < diffuse_set_.directions.size(); ++c) {
-                            Cone cone{apex, frame.to_world(diffuse_set_.directions[c]),
+                            Cone cone{sc.apex, frame.to_world(diffuse_set_.directions[c]),
                                       diffuse_set_.tan_half_angle};
-                            ConeResult r = trace_cone(view, cone, o);
+                            ConeResult r = trace_cone(view, cone, sc.options);
                             const float w = diffuse_set_.cosines[c] * diffuse_set_.weights[c];
                             E += r.radiance * w;
                             occlusion += r.occlusion * w;
@@ -645,13 +655,8 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
                         const Vec3 r = glm::reflect(-ph.wo, ph.normal);
                         const float cos_r = glm::dot(r, ph.normal);
                         if (cos_r <= 0.0f) continue;
-                        ConeOptions o = options;
-                        const float w = voxel_at(ph.position);
-                        o.start = settings_.cone_start * w;
-                        const Vec3 apex = ph.position + settings_.cone_offset * w * ph.normal;
-                        o.clip = settings_.clip_plane;
-                        o.clip_plane = Vec4(ph.normal, glm::dot(ph.normal, ph.position));
-                        ConeResult c = trace_cone(view, Cone{apex, r, phong_cone_tan(m.phong_exponent)}, o);
+                        const SurfaceCones sc = cones_at(ph);
+                        ConeResult c = trace_cone(view, Cone{sc.apex, r, phong_cone_tan(m.phong_exponent)}, sc.options);
                         put(specular, i, m.specular * c.radiance * cos_r);
                         ++local;
                     }
