@@ -32,13 +32,14 @@ float phong_lobe_pdf(float cos_a, float exponent) {
 
 Vec3 bsdf_eval(const Material& m, const Vec3& n, const Vec3& wo, const Vec3& wi) {
     if (glm::dot(n, wo) <= 0.0f || glm::dot(n, wi) <= 0.0f) return Vec3(0.0f);
-    Vec3 f = m.albedo * kInvPi;
-    if (m.has_glossy_lobe()) {
-        float ca = cos_alpha(n, wo, wi);
-        if (ca > 0.0f)
-            f += m.specular * ((m.phong_exponent + 2.0f) * (0.5f * kInvPi) * std::pow(ca, m.phong_exponent));
-    }
-    return f;
+    return m.albedo * kInvPi + bsdf_glossy(m, n, wo, wi);
+}
+
+Vec3 bsdf_glossy(const Material& m, const Vec3& n, const Vec3& wo, const Vec3& wi) {
+    if (!m.has_glossy_lobe() || glm::dot(n, wo) <= 0.0f || glm::dot(n, wi) <= 0.0f) return Vec3(0.0f);
+    float ca = cos_alpha(n, wo, wi);
+    if (!(ca > 0.0f)) return Vec3(0.0f);
+    return m.specular * ((m.phong_exponent + 2.0f) * (0.5f * kInvPi) * std::pow(ca, m.phong_exponent));
 }
 
 float bsdf_pdf(const Material& m, const Vec3& n, const Vec3& wo, const Vec3& wi) {

@@ -13,6 +13,7 @@
 #include "core/parallel.hpp"
 #include "core/rng.hpp"
 #include "techniques/photon_mapping/photon_tracer.hpp"
+#include "techniques/photon_mapping/primary_hit.hpp"
 
 #ifndef GILAB_GIT_REVISION
 #define GILAB_GIT_REVISION "unknown"
@@ -36,6 +37,16 @@ struct HitRecord {
     bool valid = false;
 };
 
+Vec3 finite_or_zero(const Vec3& v, std::atomic<uint64_t>& nonfinite) {
+    if (is_finite(v)) return v;
+    ++nonfinite;
+    return Vec3(0.0f);
+}
+
+void write_pixel(float* layer, size_t pixel, const Vec3& v) {
+    for (int c = 0; c < 3; ++c) layer[3 * pixel + size_t(c)] = v[c];
+}
+
 struct SortItem {
     uint64_t key;   // PhotonGatherer::sort_key
     uint32_t slot;  // index into the hit buffer
@@ -44,6 +55,23 @@ struct SortItem {
 };
 
 }  // namespace
+
+// The left eye's hits, kept for the right eye (stereo reuse).
+struct PhotonMappingTechnique::KeptHits {
+    std::vector<PrimaryHit> hits;              // one per left pixel
+    std::vector<LightSampleRecord> samples;    // light_samples per left pixel
+    size_t per_pixel = 0;
+    std::span<const LightSampleRecord> samples_of(size_t pixel) const {
+        return {samples.data() + pixel * per_pixel, per_pixel};
+    }
+};
+
+// What one view's render needs beyond its camera.
+struct PhotonMappingTechnique::ViewOptions {
+    uint64_t view = 0;                       // light-sample stream of pixels keyed by themselves
+    const EyeCamera* stream_eye = nullptr;   // stereo right eye: key by the left pixel seeing the point
+    KeptHits* keep = nullptr;                // keep every hit (left eye of a reusing stereo render)
+};
 
 PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     PhotonMappingSettings p;
@@ -60,6 +88,13 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     p.light_samples = s.get<int>("light_samples", p.light_samples);
     p.max_photon_depth = s.get<int>("max_photon_depth", p.max_photon_depth);
     p.tile_size = s.get<int>("tile_size", p.tile_size);
+    p.stereo.enabled = s.get<bool>("stereo_reuse", p.stereo.enabled);
+    std::string match = s.get<std::string>("stereo_match", to_string(p.stereo.match));
+    p.stereo.tolerance = s.get<float>("stereo_tolerance", p.stereo.tolerance);
+    p.stereo.reshade = s.get<bool>("stereo_reshade", p.stereo.reshade);
+    p.foveation.enabled = s.get<bool>("foveated", p.foveation.enabled);
+    p.foveation.fovea_degrees = s.get<float>("fovea_angle", p.foveation.fovea_degrees);
+    p.foveation.periphery_photon_stride = s.get<int>("periphery_photon_stride", p.foveation.periphery_photon_stride);
 
     if (photons < 1) throw Error(where, "setting 'photons' must be at least 1, got " + std::to_string(photons));
     p.photons = uint64_t(photons);
@@ -89,6 +124,31 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     if (p.max_photon_depth < 1)
         throw Error(where, "setting 'max_photon_depth' must be at least 1, got " + std::to_string(p.max_photon_depth));
     if (p.tile_size < 1) throw Error(where, "setting 'tile_size' must be at least 1, got " + std::to_string(p.tile_size));
+    if (match == "nearest")
+        p.stereo.match = StereoMatch::Nearest;
+    else if (match == "strict")
+        p.stereo.match = StereoMatch::Strict;
+    else
+        throw Error(where, "setting 'stereo_match' must be 'nearest' or 'strict', got '" + match + "'");
+    if (!(p.stereo.tolerance >= 0.0f) || !std::isfinite(p.stereo.tolerance))
+        throw Error(where, "setting 'stereo_tolerance' must be a finite number of pixels ≥ 0, got " + number(p.stereo.tolerance));
+    if (p.light_samples > 0xffff)
+        throw Error(where, "setting 'light_samples' must be at most 65535, got " + std::to_string(p.light_samples));
+    if (p.foveation.enabled) {
+        const float angle = p.foveation.fovea_degrees;
+        if (!(angle > 0.0f && angle < 180.0f))
+            throw Error(where, "setting 'fovea_angle' must be in (0, 180) degrees, got " + number(angle));
+        if (p.foveation.periphery_photon_stride < 1)
+            throw Error(where, "setting 'periphery_photon_stride' must be at least 1, got " +
+                                   std::to_string(p.foveation.periphery_photon_stride));
+        if (p.split || p.tile_shared)
+            throw Error(where, "setting 'foveated' needs pass=fused and tile_shared=false (it picks the shading rate per block)");
+        if (p.tile_size % 4 != 0)
+            throw Error(where, "setting 'foveated' needs a tile_size that is a multiple of 4 (4×4 shading blocks), got " +
+                                   std::to_string(p.tile_size));
+        if (p.stereo.enabled)
+            throw Error(where, "settings 'foveated' and 'stereo_reuse' cannot be combined yet");
+    }
     return p;
 }
 
@@ -113,6 +173,23 @@ void PhotonMappingTechnique::trace_and_build() {
     PhotonTraceResult traced = trace_photons(scene_.tracer(), scene_.frame(), scene_.materials(), scene_.lights(), ts);
     const size_t stored = traced.photons.size();
     Stopwatch build;
+    periphery_map_.reset();
+    if (settings_.foveation.enabled) {
+        // Every stride-th photon in trace order (a random subset) carrying stride × the flux.
+        const size_t stride = size_t(settings_.foveation.periphery_photon_stride);
+        std::vector<Photon> kept;
+        kept.reserve(stored / stride + 1);
+        for (size_t i = 0; i < stored; i += stride) {
+            Photon p = traced.photons[i];
+            p.power *= float(stride);
+            kept.push_back(p);
+        }
+        auto periphery = make_photon_map(settings_.photon_map);
+        if (auto* grid = dynamic_cast<HashGridPhotonMap*>(periphery.get())) grid->set_query_mode(settings_.hash_query);
+        periphery->build(std::move(kept), settings_.radius);
+        stats_.set("periphery_photons_stored", double(periphery->size()));
+        periphery_map_ = std::move(periphery);
+    }
     auto map = make_photon_map(settings_.photon_map);
     if (auto* grid = dynamic_cast<HashGridPhotonMap*>(map.get())) grid->set_query_mode(settings_.hash_query);
     map->build(std::move(traced.photons), settings_.radius);
@@ -135,56 +212,66 @@ void PhotonMappingTechnique::update(double time) {
     stats_.set("update_ms", watch.elapsed_ms());
 }
 
-void PhotonMappingTechnique::render_view(const EyeCamera& camera, uint64_t view, Film& film,
+void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOptions& options, Film& film,
                                          PhotonQueryStats& query_stats, Stats& frame_stats) const {
     const int width = camera.width(), height = camera.height();
     const PhotonMappingSettings& s = settings_;
     const PhotonGatherer gatherer(*map_, scene_.materials(), s.gather, s.radius, size_t(s.k));
+    std::optional<PhotonGatherer> periphery;
+    if (periphery_map_) periphery.emplace(*periphery_map_, scene_.materials(), s.gather, s.radius, size_t(s.k));
+    const PrimaryShadingContext shading{scene_.tracer(), scene_.frame(), scene_.materials(), scene_.lights(),
+                                        s.light_samples};
     float* direct = film.layer("direct").data.data();
     float* indirect = film.layer("indirect").data.data();
     std::mutex merge;
-    std::atomic<uint64_t> nonfinite{0}, groups{0}, grouped_hits{0}, fetched{0};
+    std::atomic<uint64_t> nonfinite{0}, groups{0}, grouped_hits{0}, fetched{0}, shaded{0};
+    KeptHits* keep = options.keep;
+    if (keep) {
+        keep->per_pixel = size_t(std::max(s.light_samples, 0));
+        keep->hits.assign(film.pixel_count(), PrimaryHit{});
+        keep->samples.assign(film.pixel_count() * keep->per_pixel, LightSampleRecord{});
+    }
 
-    // Primary ray, emission and next-event estimation; the hit is returned for the gather.
-    auto trace_pixel = [&](int x, int y) {
+    // The light-sample stream of a hit: its own pixel's, or in a stereo right eye the
+    // stream of the left pixel that sees the same point (stereo-consistent noise).
+    auto stream_of = [&](const Vec3& x, uint32_t pixel) {
+        if (options.stream_eye)
+            if (auto q = options.stream_eye->pixel_of(x))
+                return Rng::for_sample(s.seed, uint64_t(q->y) * uint64_t(options.stream_eye->width()) + uint64_t(q->x), 0, 0);
+        return Rng::for_sample(s.seed, pixel, 0, options.view);
+    };
+    // Primary ray through (px, py), emission and next-event estimation for `pixel`; the
+    // hit is returned for the gather and its direct radiance written.
+    auto trace_pixel = [&](float px, float py, uint32_t pixel) {
+        thread_local std::vector<LightSampleRecord> scratch_samples;
         HitRecord rec;
-        rec.pixel = uint32_t(size_t(y) * size_t(width) + size_t(x));
+        rec.pixel = pixel;
         Vec3 L(0.0f);
-        Ray ray = camera.generate_ray(float(x) + 0.5f, float(y) + 0.5f);
+        Ray ray = camera.generate_ray(px, py);
         Hit hit = scene_.tracer().intersect(ray);
         if (hit.valid()) {
             SurfaceInteraction si = make_interaction(scene_.frame(), ray, hit);
             const Material& m = scene_.materials()[si.material];
-            if (m.is_emissive() && !si.back_face) L += m.emission;
-            if (s.light_samples > 0 && !scene_.lights().empty()) {
-                Rng rng = Rng::for_sample(s.seed, rec.pixel, 0, view);
-                Vec3 sum(0.0f);
-                for (int k = 0; k < s.light_samples; ++k) {
-                    LightSample ls = scene_.lights().sample_incident(si.position, rng);
-                    if (!(ls.pdf > 0.0f) || is_black(ls.Li) || glm::dot(ls.wi, si.geometric_normal) <= 0.0f) continue;
-                    Vec3 f = bsdf_eval(m, si.shading_normal, si.wo, ls.wi);
-                    if (is_black(f) || scene_.tracer().occluded(shadow_ray(si, ls))) continue;
-                    sum += f * ls.Li * (glm::dot(si.shading_normal, ls.wi) / ls.pdf);
-                }
-                L += sum / float(s.light_samples);
+            PrimaryHit ph = primary_hit_of(si, m);
+            std::span<LightSampleRecord> samples;
+            if (keep) {
+                samples = {keep->samples.data() + size_t(pixel) * keep->per_pixel, keep->per_pixel};
+            } else {
+                scratch_samples.resize(size_t(std::max(s.light_samples, 0)));
+                samples = scratch_samples;
             }
-            rec.point = {si.position, si.shading_normal, si.wo, si.material};
+            Rng rng = stream_of(si.position, pixel);
+            sample_direct_light(shading, si, rng, samples, ph);
+            L = direct_radiance(m, ph, si.wo, samples);
+            rec.point = ph.point;
             rec.valid = true;
+            if (keep) keep->hits[pixel] = ph;
         }
-        if (!is_finite(L)) {
-            ++nonfinite;
-            L = Vec3(0.0f);
-        }
-        for (int c = 0; c < 3; ++c) direct[3 * size_t(rec.pixel) + size_t(c)] = L[c];
+        write_pixel(direct, pixel, finite_or_zero(L, nonfinite));
         return rec;
     };
-    auto write_indirect = [&](uint32_t pixel, Vec3 v) {
-        if (!is_finite(v)) {
-            ++nonfinite;
-            v = Vec3(0.0f);
-        }
-        for (int c = 0; c < 3; ++c) indirect[3 * size_t(pixel) + size_t(c)] = v[c];
-    };
+    auto pixel_index = [&](int x, int y) { return uint32_t(size_t(y) * size_t(width) + size_t(x)); };
+    auto write_indirect = [&](uint32_t pixel, Vec3 v) { write_pixel(indirect, pixel, finite_or_zero(v, nonfinite)); };
     // Gathers hits[items[b..e).slot]: runs of hits sharing a cell together (Algorithm 1)
     // when `shared`, else one by one.
     auto gather_sorted = [&](const std::vector<HitRecord>& hits, const std::vector<SortItem>& items, size_t b, size_t e,
@@ -231,25 +318,58 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, uint64_t view,
         }
         return items;
     };
+    // Foveated tile: 4×4 blocks, each shaded at the rate its eccentricity allows; a
+    // coarse sample (at its block's centre, with its top-left pixel's light stream and
+    // the periphery photon map) is copied to every pixel of its block.
+    auto shade_foveated_tile = [&](const Tile& tile, GatherScratch& scratch, PhotonQueryStats& qs) {
+        uint64_t samples_taken = 0;
+        for (int by = tile.y0; by < tile.y1; by += 4)
+            for (int bx = tile.x0; bx < tile.x1; bx += 4) {
+                const int bx1 = std::min(bx + 4, tile.x1), by1 = std::min(by + 4, tile.y1);
+                const int b = foveated_block_size(camera, s.foveation, 0.5f * float(bx + bx1), 0.5f * float(by + by1));
+                const PhotonGatherer& g = b == 1 ? gatherer : *periphery;
+                for (int sy = by; sy < by1; sy += b)
+                    for (int sx = bx; sx < bx1; sx += b) {
+                        const int ex = std::min(sx + b, bx1), ey = std::min(sy + b, by1);
+                        const uint32_t rep = pixel_index(sx, sy);
+                        HitRecord rec = trace_pixel(0.5f * float(sx + ex), 0.5f * float(sy + ey), rep);
+                        write_indirect(rep, rec.valid ? g.estimate(rec.point, scratch, qs) : Vec3(0.0f));
+                        ++samples_taken;
+                        for (int y = sy; y < ey; ++y)
+                            for (int x = sx; x < ex; ++x) {
+                                const uint32_t p = pixel_index(x, y);
+                                if (p == rep) continue;
+                                for (int c = 0; c < 3; ++c) {
+                                    direct[3 * size_t(p) + size_t(c)] = direct[3 * size_t(rep) + size_t(c)];
+                                    indirect[3 * size_t(p) + size_t(c)] = indirect[3 * size_t(rep) + size_t(c)];
+                                }
+                            }
+                    }
+            }
+        shaded += samples_taken;
+    };
 
     if (!s.split) {
         Stopwatch watch;
         parallel_for_tiles(width, height, s.tile_size, [&](const Tile& tile) {
             GatherScratch scratch;
             PhotonQueryStats qs;
-            if (!s.tile_shared) {
+            if (s.foveation.enabled) {
+                shade_foveated_tile(tile, scratch, qs);
+            } else if (!s.tile_shared) {
                 for (int y = tile.y0; y < tile.y1; ++y)
                     for (int x = tile.x0; x < tile.x1; ++x) {
-                        HitRecord rec = trace_pixel(x, y);
+                        HitRecord rec = trace_pixel(float(x) + 0.5f, float(y) + 0.5f, pixel_index(x, y));
                         write_indirect(rec.pixel, rec.valid ? gatherer.estimate(rec.point, scratch, qs) : Vec3(0.0f));
                     }
+                shaded += uint64_t(tile.x1 - tile.x0) * uint64_t(tile.y1 - tile.y0);
             } else {
                 // Trace the tile, then group its hits by cell.
                 std::vector<HitRecord> tile_hits;
                 std::vector<uint32_t> valid;
                 for (int y = tile.y0; y < tile.y1; ++y)
                     for (int x = tile.x0; x < tile.x1; ++x) {
-                        HitRecord rec = trace_pixel(x, y);
+                        HitRecord rec = trace_pixel(float(x) + 0.5f, float(y) + 0.5f, pixel_index(x, y));
                         if (rec.valid)
                             valid.push_back(uint32_t(tile_hits.size()));
                         else
@@ -258,6 +378,7 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, uint64_t view,
                     }
                 std::vector<SortItem> items = sort_items(tile_hits, valid);
                 gather_sorted(tile_hits, items, 0, items.size(), scratch, qs, true);
+                shaded += tile_hits.size();
             }
             fetched += scratch.fetched;
             std::lock_guard<std::mutex> lock(merge);
@@ -271,10 +392,11 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, uint64_t view,
         parallel_for_tiles(width, height, s.tile_size, [&](const Tile& tile) {
             for (int y = tile.y0; y < tile.y1; ++y)
                 for (int x = tile.x0; x < tile.x1; ++x) {
-                    HitRecord rec = trace_pixel(x, y);
+                    HitRecord rec = trace_pixel(float(x) + 0.5f, float(y) + 0.5f, pixel_index(x, y));
                     hits[rec.pixel] = rec;
                 }
         });
+        shaded += hits.size();
         frame_stats.add("trace_pass_ms", trace_watch.elapsed_ms());
         // Pass 2: gather in cell order for memory coherence, results written by pixel.
         Stopwatch sort_watch;
@@ -317,21 +439,149 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, uint64_t view,
     frame_stats.add("tile_groups", double(groups.load()));
     frame_stats.add("tile_grouped_hits", double(grouped_hits.load()));
     frame_stats.add("tile_fetched_photons", double(fetched.load()));
+    frame_stats.add("shaded_samples", double(shaded.load()));
+}
+
+void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const EyeCamera& right, const KeptHits& kept,
+                                                  const Film& left_film, Film& film, PhotonQueryStats& query_stats,
+                                                  Stats& frame_stats) const {
+    const PhotonMappingSettings& s = settings_;
+    Stopwatch claim_watch;
+    const StereoClaims claims(kept.hits, left, right, scene_.tracer());
+    frame_stats.add("claim_ms", claim_watch.elapsed_ms());
+
+    Stopwatch right_watch;
+    const int width = right.width();
+    const PhotonGatherer gatherer(*map_, scene_.materials(), s.gather, s.radius, size_t(s.k));
+    const PrimaryShadingContext shading{scene_.tracer(), scene_.frame(), scene_.materials(), scene_.lights(),
+                                        s.light_samples};
+    const float* left_direct = left_film.layer("direct").data.data();
+    const float* left_indirect = left_film.layer("indirect").data.data();
+    float* direct = film.layer("direct").data.data();
+    float* indirect = film.layer("indirect").data.data();
+    float* reused_layer = film.add_layer("reused", 1).data.data();
+    const Vec3 eye = right.position();
+    std::mutex merge;
+    std::atomic<uint64_t> nonfinite{0}, reused{0}, reshaded_glossy{0}, strict_rejected{0}, shaded{0};
+
+    auto load = [](const float* layer, size_t pixel) {
+        return Vec3(layer[3 * pixel], layer[3 * pixel + 1], layer[3 * pixel + 2]);
+    };
+
+    parallel_for_tiles(width, right.height(), s.tile_size, [&](const Tile& tile) {
+        GatherScratch scratch;
+        PhotonQueryStats qs;
+        std::vector<LightSampleRecord> samples(size_t(std::max(s.light_samples, 0)));
+        uint64_t n_reused = 0, n_glossy = 0, n_rejected = 0, n_shaded = 0;
+        for (int y = tile.y0; y < tile.y1; ++y)
+            for (int x = tile.x0; x < tile.x1; ++x) {
+                const uint32_t pixel = uint32_t(size_t(y) * size_t(width) + size_t(x));
+                const uint32_t source = claims.source(pixel);
+                Vec3 Ld(0.0f), Li(0.0f);
+                bool from_left = source != StereoClaims::kNone;
+                std::optional<SurfaceInteraction> own;  // the right pixel's own hit, if traced
+                Ray ray;
+                if (!from_left || s.stereo.match == StereoMatch::Strict) {
+                    ray = right.generate_ray(float(x) + 0.5f, float(y) + 0.5f);
+                    Hit hit = scene_.tracer().intersect(ray);
+                    if (hit.valid()) own = make_interaction(scene_.frame(), ray, hit);
+                    if (from_left) {
+                        PrimaryHit mine;
+                        if (own) mine = primary_hit_of(*own, scene_.materials()[own->material]);
+                        from_left = same_surface_point(kept.hits[source], mine, right, s.stereo.tolerance);
+                        n_rejected += !from_left;
+                    }
+                }
+                if (from_left) {
+                    const PrimaryHit& h = kept.hits[source];
+                    const Material& m = scene_.materials()[h.point.material];
+                    if (s.stereo.reshade) {
+                        // View-independent parts from the left eye; the glossy lobe for this eye.
+                        const Vec3 wo = glm::normalize(eye - h.point.position);
+                        Ld = direct_radiance(m, h, wo, kept.samples_of(source));
+                        if (m.has_glossy_lobe()) {
+                            GatherPoint p = h.point;
+                            p.wo = wo;
+                            Li = gatherer.estimate(p, scratch, qs);
+                            ++n_glossy;
+                        } else {
+                            Li = load(left_indirect, source);
+                        }
+                    } else {
+                        Ld = load(left_direct, source);
+                        Li = load(left_indirect, source);
+                    }
+                    ++n_reused;
+                    reused_layer[pixel] = 1.0f;
+                } else if (own) {
+                    // Nobody claimed it (or strict mode refused): shade it as an independent eye.
+                    const Material& m = scene_.materials()[own->material];
+                    PrimaryHit ph = primary_hit_of(*own, m);
+                    Rng rng = [&] {
+                        if (auto q = left.pixel_of(own->position))
+                            return Rng::for_sample(s.seed, uint64_t(q->y) * uint64_t(left.width()) + uint64_t(q->x), 0, 0);
+                        return Rng::for_sample(s.seed, pixel, 0, 1);
+                    }();
+                    sample_direct_light(shading, *own, rng, samples, ph);
+                    Ld = direct_radiance(m, ph, own->wo, samples);
+                    Li = gatherer.estimate(ph.point, scratch, qs);
+                    ++n_shaded;
+                }
+                write_pixel(direct, pixel, finite_or_zero(Ld, nonfinite));
+                write_pixel(indirect, pixel, finite_or_zero(Li, nonfinite));
+            }
+        reused += n_reused, reshaded_glossy += n_glossy, strict_rejected += n_rejected, shaded += n_shaded;
+        std::lock_guard<std::mutex> lock(merge);
+        query_stats.merge(qs);
+    });
+    float* color = film.layer("color").data.data();
+    for (size_t i = 0; i < 3 * film.pixel_count(); ++i) color[i] = direct[i] + indirect[i];
+    frame_stats.add("right_pass_ms", right_watch.elapsed_ms());
+    const StereoClaimStats& c = claims.stats();
+    frame_stats.set("reuse_left_hits", double(c.left_hits));
+    frame_stats.set("reuse_back_side", double(c.back_side));
+    frame_stats.set("reuse_outside", double(c.outside));
+    frame_stats.set("reuse_occluded", double(c.occluded));
+    frame_stats.set("reuse_candidates", double(c.candidates));
+    frame_stats.set("reuse_claimed_pixels", double(c.claimed_pixels));
+    frame_stats.set("reuse_depth_conflicts", double(c.depth_conflicts));
+    frame_stats.set("reuse_strict_rejected", double(strict_rejected.load()));
+    frame_stats.set("reused_pixels", double(reused.load()));
+    // Of the right pixels that show geometry (reused or shaded), the share reused.
+    const double covered = double(reused.load() + shaded.load());
+    frame_stats.set("reuse_fraction", covered > 0 ? double(reused.load()) / covered : 0.0);
+    frame_stats.set("reuse_reshaded_glossy", double(reshaded_glossy.load()));
+    frame_stats.set("right_shaded_pixels", double(shaded.load()));
+    frame_stats.add("nonfinite_pixels", double(nonfinite.load()));
 }
 
 void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& films) {
     if (!scene_.loaded() || !map_) throw Error("photon", "render() called before prepare()");
     Stopwatch watch;
-    films.resize(views.views.size());
+    films.assign(views.views.size(), Film());
     PhotonQueryStats queries;
     Stats frame;
+    const bool stereo = views.stereo();
+    const bool reuse = stereo && settings_.stereo.enabled;
+    KeptHits kept;
     for (size_t v = 0; v < views.views.size(); ++v) {
         const EyeCamera& camera = views.views[v];
-        check_resolution(camera.width(), camera.height(), 3);
+        check_resolution(camera.width(), camera.height(), 4);
         Film film(camera.width(), camera.height());
         film.add_layer("direct");
         film.add_layer("indirect");
-        render_view(camera, v, film, queries, frame);
+        Stopwatch view_watch;
+        if (reuse && v == 1) {
+            render_right_reusing(views.views[0], camera, kept, films[0], film, queries, frame);
+        } else {
+            ViewOptions options;
+            options.view = v;
+            if (stereo && v == 1) options.stream_eye = &views.views[0];
+            if (reuse && v == 0) options.keep = &kept;
+            render_view(camera, options, film, queries, frame);
+        }
+        const double view_ms = view_watch.elapsed_ms();
+        if (stereo) frame.set(v == 0 ? "left_ms" : "right_ms", view_ms);
         film.metadata["technique"] = "photon";
         film.metadata["view"] = v < views.names.size() ? views.names[v] : "mono";
         film.metadata["photons"] = std::to_string(settings_.photons);
@@ -339,14 +589,20 @@ void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& fil
         film.metadata["gather"] = settings_.gather == GatherMode::Knn ? "knn" : "radius";
         film.metadata["photon_map"] = to_string(settings_.photon_map);
         film.metadata["seed"] = std::to_string(settings_.seed);
+        if (stereo) film.metadata["stereo_reuse"] = reuse ? to_string(settings_.stereo.match) : "off";
         film.metadata["config_hash"] = config_hash_;
         film.metadata["git_revision"] = GILAB_GIT_REVISION;
         films[v] = std::move(film);
     }
     double ms = watch.elapsed_ms();
     for (Film& film : films) film.metadata["render_time_seconds"] = number(ms / 1000.0);
+    // Per-frame figures replace the previous frame's.
     for (const char* key : {"fused_ms", "trace_pass_ms", "sort_ms", "gather_pass_ms", "nonfinite_pixels", "tile_groups",
-                            "tile_grouped_hits", "tile_fetched_photons"})
+                            "tile_grouped_hits", "tile_fetched_photons", "shaded_samples", "left_ms", "right_ms",
+                            "claim_ms", "right_pass_ms", "reuse_left_hits", "reuse_back_side", "reuse_outside",
+                            "reuse_occluded", "reuse_candidates", "reuse_claimed_pixels", "reuse_depth_conflicts",
+                            "reuse_strict_rejected", "reused_pixels", "reuse_fraction", "reuse_reshaded_glossy",
+                            "right_shaded_pixels"})
         stats_.set(key, frame.get(key));
     stats_.set("render_ms", ms);
     stats_.set("gather_queries", double(queries.queries));

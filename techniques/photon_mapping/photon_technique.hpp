@@ -17,6 +17,20 @@
 // are all evaluated against it; hash grid only; bit-identical), seed (1),
 // light_samples (1), max_photon_depth (8: surface hits along a photon path),
 // tile_size (16). Primary rays go through pixel centres.
+//
+// Stereo (a two-view render): the right eye draws its light samples from the stream of
+// the left pixel that sees the same point, so both eyes show the same noise on a surface
+// (no binocular rivalry from independent noise) and the stereo-reuse error below measures
+// geometry, not noise. stereo_reuse (false) fills right-eye pixels from the left eye's
+// hits (stereo_reuse.hpp); stereo_match (nearest: the paper's claim | strict: only where
+// the right pixel's own ray hits the same point within stereo_tolerance (0.25) pixel
+// footprints), stereo_reshade (true: re-evaluate the glossy lobe for the right eye;
+// false: copy the left colour, the paper's behaviour). The right film gets a "reused"
+// layer (1 where the pixel came from the left eye).
+//
+// Foveation (foveation.hpp): foveated (false), fovea_angle (10 degrees),
+// periphery_photon_stride (4). Needs pass=fused, tile_shared=false, a tile_size that is a
+// multiple of 4, and no stereo_reuse.
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -25,7 +39,9 @@
 #include "accel/photon_map.hpp"
 #include "core/light_sampler.hpp"
 #include "core/ray_tracer.hpp"
+#include "techniques/photon_mapping/foveation.hpp"
 #include "techniques/photon_mapping/photon_gather.hpp"
+#include "techniques/photon_mapping/stereo_reuse.hpp"
 #include "core/traced_scene.hpp"
 #include "techniques/technique.hpp"
 
@@ -44,6 +60,8 @@ struct PhotonMappingSettings {
     int light_samples = 1;
     int max_photon_depth = 8;
     int tile_size = 16;
+    StereoReuseSettings stereo;
+    FoveationSettings foveation;
 
     // Reads every key above (with get, so the caller can report the rest) and checks
     // the values; throws Error naming the bad key.
@@ -62,14 +80,19 @@ public:
     const PhotonMap& photon_map() const { return *map_; }
 
 private:
+    struct KeptHits;
+    struct ViewOptions;
     void trace_and_build();
-    void render_view(const EyeCamera& camera, uint64_t view, Film& film, PhotonQueryStats& query_stats,
+    void render_view(const EyeCamera& camera, const ViewOptions& options, Film& film, PhotonQueryStats& query_stats,
                      Stats& frame_stats) const;
+    void render_right_reusing(const EyeCamera& left, const EyeCamera& right, const KeptHits& kept, const Film& left_film,
+                              Film& film, PhotonQueryStats& query_stats, Stats& frame_stats) const;
 
     PhotonMappingSettings settings_;
     std::string config_hash_;
     TracedScene scene_;
     std::unique_ptr<PhotonMap> map_;
+    std::unique_ptr<PhotonMap> periphery_map_;  // foveation: every stride-th photon
     Stats stats_;
 };
 

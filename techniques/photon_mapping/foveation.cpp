@@ -1,0 +1,20 @@
+#include "techniques/photon_mapping/foveation.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace gilab {
+
+float eccentricity_degrees(const EyeCamera& eye, float px, float py) {
+    const float c = std::clamp(glm::dot(eye.generate_ray(px, py).direction, eye.forward()), -1.0f, 1.0f);
+    return std::acos(c) * (180.0f / kPi);
+}
+
+int foveated_block_size(const EyeCamera& eye, const FoveationSettings& settings, float px, float py) {
+    if (!settings.enabled) return 1;
+    const float e = eccentricity_degrees(eye, px, py);
+    if (e <= settings.fovea_degrees) return 1;
+    return e <= 2.0f * settings.fovea_degrees ? 2 : 4;
+}
+
+}  // namespace gilab

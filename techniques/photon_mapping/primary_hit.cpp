@@ -1,0 +1,47 @@
+#include "techniques/photon_mapping/primary_hit.hpp"
+
+#include "core/bsdf.hpp"
+
+namespace gilab {
+
+PrimaryHit primary_hit_of(const SurfaceInteraction& si, const Material& m) {
+    PrimaryHit out;
+    out.valid = true;
+    out.point = {si.position, si.shading_normal, si.wo, si.material};
+    out.geometric_normal = si.geometric_normal;
+    out.triangle = si.triangle;
+    out.mesh = si.mesh;
+    if (m.is_emissive() && !si.back_face) out.emitted = m.emission;
+    return out;
+}
+
+void sample_direct_light(const PrimaryShadingContext& ctx, const SurfaceInteraction& si, Rng& rng,
+                         std::span<LightSampleRecord> samples, PrimaryHit& hit) {
+    const Material& m = ctx.materials[si.material];
+    // A black surface reflects nothing whatever the samples say: skip its shadow rays.
+    const bool reflects = max_component(m.albedo) > 0.0f || m.has_glossy_lobe();
+    if (ctx.light_samples <= 0 || ctx.lights.empty() || !reflects) return;
+    const float inv_n = 1.0f / float(ctx.light_samples);
+    for (int k = 0; k < ctx.light_samples; ++k) {
+        LightSample ls = ctx.lights.sample_incident(si.position, rng);
+        if (!(ls.pdf > 0.0f) || is_black(ls.Li) || glm::dot(ls.wi, si.geometric_normal) <= 0.0f) continue;
+        const float cos_i = glm::dot(si.shading_normal, ls.wi);
+        if (!(cos_i > 0.0f) || ctx.tracer.occluded(shadow_ray(si, ls))) continue;
+        LightSampleRecord rec{ls.wi, ls.Li * (cos_i / ls.pdf * inv_n)};
+        hit.irradiance += rec.weight;
+        if (hit.sample_count < samples.size()) samples[hit.sample_count++] = rec;
+    }
+}
+
+Vec3 direct_radiance(const Material& m, const PrimaryHit& hit, const Vec3& wo, std::span<const LightSampleRecord> samples) {
+    Vec3 L = hit.emitted;
+    const Vec3& n = hit.point.normal;
+    if (glm::dot(n, wo) <= 0.0f) return L;  // the BSDF is zero below the shading horizon
+    L += bsdf_diffuse(m) * hit.irradiance;
+    if (m.has_glossy_lobe())
+        for (size_t k = 0; k < hit.sample_count && k < samples.size(); ++k)
+            L += bsdf_glossy(m, n, wo, samples[k].wi) * samples[k].weight;
+    return L;
+}
+
+}  // namespace gilab

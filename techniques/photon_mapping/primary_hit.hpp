@@ -1,0 +1,58 @@
+#pragma once
+// What the photon technique knows about a primary hit, split into the part that does not
+// depend on the viewing direction (position, normal, emission, the irradiance from the
+// unoccluded light samples, and the samples themselves) and the view-dependent glossy
+// lobe, which is evaluated from it for any eye position. The left eye's hits are kept in
+// this form so the right eye can reuse them (stereo_reuse.hpp) and re-evaluate only the
+// lobe for its own direction.
+#include <cstdint>
+#include <span>
+#include <vector>
+#include "core/camera.hpp"
+#include "core/interaction.hpp"
+#include "core/light_sampler.hpp"
+#include "core/ray_tracer.hpp"
+#include "techniques/photon_mapping/photon_gather.hpp"
+
+namespace gilab {
+
+// One unoccluded light sample: direction and Li·cosθ / (pdf · N) for N samples.
+struct LightSampleRecord {
+    Vec3 wi{0};
+    Vec3 weight{0};
+};
+
+struct PrimaryHit {
+    GatherPoint point;          // position, shading normal (viewer side), wo, material
+    Vec3 geometric_normal{0};   // viewer side
+    Vec3 emitted{0};            // emission towards the viewer (front faces only)
+    Vec3 irradiance{0};         // Σ LightSampleRecord::weight: the Lambertian direct term / (ρ/π)
+    uint32_t triangle = kInvalidId, mesh = kInvalidId;
+    uint16_t sample_count = 0;  // records at samples[pixel · light_samples ...]
+    bool valid = false;
+};
+
+// Everything a view's hits are shaded with.
+struct PrimaryShadingContext {
+    const RayTracer& tracer;
+    const SceneFrame& frame;
+    const std::vector<Material>& materials;
+    const LightSampler& lights;
+    int light_samples = 1;
+};
+
+// The geometry of a hit and the emission the viewer sees; no lighting yet.
+PrimaryHit primary_hit_of(const SurfaceInteraction& si, const Material& m);
+
+// Next-event estimation at the hit: light samples drawn from `rng`, the unoccluded ones
+// summed into hit.irradiance and stored in `samples` (size light_samples).
+void sample_direct_light(const PrimaryShadingContext& ctx, const SurfaceInteraction& si, Rng& rng,
+                         std::span<LightSampleRecord> samples, PrimaryHit& hit);
+
+// Direct radiance of a hit towards a viewer in direction wo (unit, from the point):
+// emission + ρ/π · irradiance + Σ glossy(wo, wi) · weight. The same arithmetic for the
+// eye that traced the hit and for an eye that reuses it, so a Lambertian hit gives
+// bit-identical radiance to both.
+Vec3 direct_radiance(const Material& m, const PrimaryHit& hit, const Vec3& wo, std::span<const LightSampleRecord> samples);
+
+}  // namespace gilab
