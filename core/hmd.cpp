@@ -207,4 +207,20 @@ HeadPose sample_head_pose(const std::vector<HeadPoseSample>& trace, double time)
     return pose;
 }
 
+HeadPose trace_pose_relative_to(const HeadPose& base, const std::vector<HeadPoseSample>& trace,
+                                double time, float scale) {
+    if (trace.empty()) throw Error("trace_pose_relative_to", "empty head-pose trace");
+    // Exactly the base up to the first sample (q0⁻¹·q0 is only nearly identity in floats).
+    if (!(time > trace.front().time)) return base;
+    const HeadPose& first = trace.front().pose;
+    HeadPose now = sample_head_pose(trace, time);
+    Quat inverse_first = glm::conjugate(first.orientation);  // unit quaternions
+    Quat delta_rotation = inverse_first * now.orientation;
+    Vec3 delta_position = inverse_first * (now.position - first.position);
+    HeadPose pose;
+    pose.orientation = glm::normalize(base.orientation * delta_rotation);
+    pose.position = base.position + base.orientation * (scale * delta_position);
+    return pose;
+}
+
 }  // namespace gilab

@@ -53,5 +53,11 @@ struct HeadPoseSample {
 std::vector<HeadPoseSample> load_head_pose_trace(const std::string& path);
 // Pose at time t: linear in position, slerp in orientation, clamped at the ends.
 HeadPose sample_head_pose(const std::vector<HeadPoseSample>& trace, double time);
+// The trace's motion since its first sample, replayed from `base`: the head turns by
+// q0⁻¹·q(t) and moves by q0⁻¹·(p(t) − p0) (in the head's own frame, times `scale`), so a
+// trace recorded in any tracking space drives any scene from that scene's own head pose.
+// `scale` converts trace metres to scene units. Throws Error on an empty trace.
+HeadPose trace_pose_relative_to(const HeadPose& base, const std::vector<HeadPoseSample>& trace,
+                                double time, float scale = 1.0f);
 
 }  // namespace gilab

@@ -43,6 +43,30 @@ double relative_mse(const Film& image, const Film& reference, const std::string&
     return sum / double(a.size());
 }
 
+double relative_mse_masked(const Film& image, const Film& reference, const std::vector<uint8_t>& mask,
+                           const std::string& layer, double epsilon) {
+    check_comparable(image, reference, layer, "relative_mse_masked");
+    if (!(epsilon > 0.0)) throw Error("relative_mse_masked", "epsilon must be positive");
+    if (mask.size() != image.pixel_count())
+        throw Error("relative_mse_masked", "mask has " + std::to_string(mask.size()) + " entries for " +
+                                               std::to_string(image.pixel_count()) + " pixels");
+    const Layer& a = image.layer(layer);
+    const Layer& r = reference.layer(layer);
+    const size_t channels = size_t(a.channels);
+    double sum = 0.0;
+    size_t count = 0;
+    for (size_t p = 0; p < mask.size(); ++p) {
+        if (!mask[p]) continue;
+        for (size_t c = 0; c < channels; ++c) {
+            double d = double(a.data[p * channels + c]) - double(r.data[p * channels + c]);
+            double ref = double(r.data[p * channels + c]);
+            sum += d * d / (ref * ref + epsilon);
+        }
+        count += channels;
+    }
+    return count ? sum / double(count) : 0.0;
+}
+
 double mean_value(const Film& image, const std::string& layer) {
     const auto& data = image.layer(layer).data;
     if (data.empty()) return 0.0;

@@ -100,6 +100,13 @@ int main(int argc, char** argv) {
     render->add_option("--settings", request.settings_file, "technique settings as a JSON object file");
     render->add_option("--set", request.assignments, "technique setting key=value (repeatable)");
     render->add_option("--exposure", request.exposure, "PNG preview exposure in stops");
+    render->add_option("--head-trace", request.head_trace,
+                       "head-pose trace CSV (t,px,py,pz,qw,qx,qy,qz; needs --hmd): render a frame sequence, the head "
+                       "moving from the scene's HMD pose as the trace moves from its first sample");
+    render->add_option("--frames", request.frames, "frames to render along the trace (default: duration × fps)");
+    render->add_option("--fps", request.fps, "frames per second along the trace (default 30)");
+    render->add_option("--trace-scale", request.trace_scale,
+                       "scene units per metre of trace motion (default 1, for metre-scale scenes such as cornell)");
 
     std::string info_scene;
     auto* info = app.add_subcommand("info", "describe a scene: triangles, materials, lights, bounds, animation, closed meshes");

@@ -13,6 +13,7 @@
 #include "core/settings.hpp"
 #include "core/stats.hpp"
 #include "experiments/experiment.hpp"
+#include "experiments/path_reference.hpp"
 #include "scenes/builtin_scenes.hpp"
 #include "techniques/technique.hpp"
 
@@ -66,55 +67,6 @@ double median(std::vector<double> v) {
     return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
-// The path-traced reference at pixel centres (as the photon renders), cached by its
-// settings: in this experiment's directory, or copied from a sibling pm-* directory.
-Film reference_image(const ExperimentContext& ctx, const Scene& scene, const EyeCamera& camera, int spp,
-                     std::vector<std::string>& files) {
-    nlohmann::json settings = {{"spp", spp}, {"seed", ctx.seed}, {"max_depth", 8}, {"jitter", false}};
-    nlohmann::json key = settings;
-    key["scene"] = scene.name;
-    key["width"] = camera.width();
-    key["height"] = camera.height();
-    const std::string name = "reference_path_" + std::to_string(camera.width()) + "px_" + std::to_string(spp) + "spp_" +
-                             Settings(key).hash().substr(0, 12) + ".exr";
-    const fs::path here = ctx.output_dir / name;
-    files.push_back(name);
-    std::error_code ec;
-    if (!fs::exists(here) && fs::exists(ctx.output_dir.parent_path())) {
-        for (const auto& entry : fs::directory_iterator(ctx.output_dir.parent_path(), ec)) {
-            fs::path candidate = entry.path() / name;
-            if (entry.path().filename().string().rfind("pm-", 0) == 0 && fs::exists(candidate)) {
-                fs::copy_file(candidate, here, fs::copy_options::overwrite_existing, ec);
-                if (!ec) ctx.say("reference copied from " + candidate.string());
-                break;
-            }
-        }
-    }
-    if (fs::exists(here)) {
-        try {
-            Film film = read_exr(here);
-            if (film.width() == camera.width() && film.height() == camera.height() && film.has_layer("indirect")) {
-                ctx.say("reference from cache " + here.string());
-                return film;
-            }
-        } catch (const Error& e) {
-            ctx.say(std::string("cached reference unreadable, rendering again: ") + e.what());
-        }
-    }
-    ctx.say("rendering the path-traced reference (" + std::to_string(camera.width()) + "², " + std::to_string(spp) +
-            " spp) ...");
-    auto path = TechniqueRegistry::builtin().create("path");
-    Settings s(settings, "pm reference");
-    path->prepare(scene, s);
-    s.report_unused();
-    std::vector<Film> films;
-    path->render(ViewSet::mono(camera), films);
-    ctx.say("reference done in " + std::to_string(path->stats().get("render_ms") / 1000.0) + " s");
-    write_exr(here, films.at(0));
-    write_png(ctx.output_dir / (name.substr(0, name.size() - 4) + ".png"), films.at(0));
-    return films.at(0);
-}
-
 Setup make_setup(const ExperimentContext& ctx, ExperimentOutput& out) {
     Setup s;
     s.quick = ctx.quick;
@@ -125,7 +77,7 @@ Setup make_setup(const ExperimentContext& ctx, ExperimentOutput& out) {
     s.scene = make_cornell_box();
     const SceneCamera& c = *s.scene.camera;
     s.camera = EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, s.size, s.size);
-    s.reference = reference_image(ctx, s.scene, s.camera, s.reference_spp, out.files);
+    s.reference = path_reference(ctx, s.scene, s.camera, s.reference_spp, out.files);
     out.config["scene"] = "cornell (builtin, unit scale, 30 triangles + light)";
     out.config["resolution"] = {s.size, s.size};
     out.config["frames_per_variant"] = s.frames;

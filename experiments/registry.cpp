@@ -7,6 +7,7 @@ const ExperimentRegistry& ExperimentRegistry::builtin() {
         ExperimentRegistry r;
         register_core_experiments(r);
         register_photon_experiments(r);
+        register_stereo_experiments(r);
         register_dag_experiments(r);
         register_vct_experiments(r);
         return r;

@@ -1,6 +1,10 @@
 #include "experiments/render_command.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <sstream>
 #include "core/error.hpp"
@@ -10,6 +14,7 @@
 #include "core/mesh_topology.hpp"
 #include "experiments/result_writers.hpp"
 #include "scenes/scene_library.hpp"
+#include "techniques/stereo_frame.hpp"
 #include "techniques/technique.hpp"
 
 namespace gilab {
@@ -44,6 +49,117 @@ HeadPose pose_from_camera(const SceneCamera& c) {
     return {eye.position(), eye.orientation()};
 }
 
+struct TracePlan {
+    std::string path;
+    std::vector<HeadPoseSample> trace;
+    int frames = 1;
+    double fps = 30;
+    float scale = 1;
+};
+
+// Checks the sequence options and loads the trace, before anything is rendered or written.
+std::optional<TracePlan> plan_trace(const RenderRequest& request) {
+    if (!request.head_trace) {
+        if (request.frames || request.fps || request.trace_scale)
+            throw Error("--frames/--fps/--trace-scale", "only apply to a head-pose sequence; give --head-trace FILE");
+        return std::nullopt;
+    }
+    if (!request.hmd)
+        throw Error("--head-trace", "needs --hmd PRESET (a head-pose trace drives the stereo pair of a headset)");
+    TracePlan plan;
+    plan.path = *request.head_trace;
+    plan.fps = request.fps.value_or(30.0);
+    if (!std::isfinite(plan.fps) || !(plan.fps > 0)) throw Error("--fps", "must be a positive number of frames per second");
+    plan.scale = request.trace_scale.value_or(1.0f);
+    if (!std::isfinite(plan.scale) || plan.scale < 0)
+        throw Error("--trace-scale", "must be a finite number ≥ 0 (scene units per trace metre)");
+    if (request.frames && *request.frames < 1) throw Error("--frames", "must be at least 1");
+    plan.trace = load_head_pose_trace(plan.path);
+    double duration = plan.trace.back().time - plan.trace.front().time;
+    double frames = request.frames ? double(*request.frames) : std::max(1.0, std::round(duration * plan.fps));
+    constexpr double kMaxFrames = 1e6;  // a typo'd --fps should not queue days of rendering
+    if (frames > kMaxFrames)
+        throw Error(plan.path, "a " + std::to_string(duration) + " s trace at " + std::to_string(plan.fps) +
+                                   " fps is more than 1000000 frames; give --frames");
+    plan.frames = int(frames);
+    return plan;
+}
+
+void tag_film(Film& film, const Scene& scene, const std::string& view, const Technique& technique,
+              const Settings& settings, const RenderRequest& request, const HmdRig* rig) {
+    film.metadata["scene"] = scene.source.empty() ? scene.name : scene.source;
+    film.metadata["view"] = view;
+    film.metadata["technique"] = technique.name();
+    film.metadata["config_hash"] = settings.hash();
+    film.metadata["settings"] = settings.json().dump();
+    film.metadata["git_revision"] = git_revision();
+    film.metadata["seed"] = std::to_string(request.seed);
+    if (rig) film.metadata["hmd"] = rig->preset().name;
+}
+
+std::string default_output(const Scene& scene, const Technique& technique, bool stereo) {
+    return "results/render/" + scene.name + "_" + technique.name() + (stereo ? "_stereo" : "");
+}
+
+std::string format_number(double value, int precision) {
+    std::ostringstream out;
+    out << std::fixed << std::setprecision(precision) << value;
+    return out.str();
+}
+
+// Frame k at t = k / fps: the head follows the trace from the rig's starting pose.
+std::vector<std::string> render_sequence(const TracePlan& plan, Technique& technique, HmdRig& rig,
+                                         const Scene& scene, const Settings& settings, const RenderRequest& request) {
+    std::string base = request.output.empty() ? default_output(scene, technique, true) : request.output;
+    fs::path csv_path = base + "_frames.csv";
+    if (csv_path.has_parent_path()) fs::create_directories(csv_path.parent_path());
+
+    const HeadPose start = rig.pose();
+    std::ostringstream csv;
+    csv << "frame,time,px,py,pz,qw,qx,qy,qz,render_ms\n";
+    std::vector<std::string> written;
+    double total_ms = 0;
+    for (int k = 0; k < plan.frames; ++k) {
+        double t = k / plan.fps;
+        double scene_time = request.time + t;
+        if (scene.is_animated() || (k == 0 && request.time != 0)) technique.update(scene_time);
+        rig.set_pose(trace_pose_relative_to(start, plan.trace, plan.trace.front().time + t, plan.scale));
+        StereoFrame frame = render_stereo_frame(technique, rig);
+        total_ms += frame.render_ms;
+
+        const HeadPose& pose = rig.pose();
+        const Vec3& p = pose.position;
+        const Quat& q = pose.orientation;
+        std::string pose_text = format_number(p.x, 6) + "," + format_number(p.y, 6) + "," + format_number(p.z, 6) +
+                                "," + format_number(q.w, 7) + "," + format_number(q.x, 7) + "," +
+                                format_number(q.y, 7) + "," + format_number(q.z, 7);
+        for (auto [film, view] : {std::pair{&frame.left, "left"}, std::pair{&frame.right, "right"}}) {
+            tag_film(*film, scene, view, technique, settings, request, &rig);
+            film->metadata["frame"] = std::to_string(k);
+            film->metadata["time"] = format_number(scene_time, 6);
+            film->metadata["head_trace"] = plan.path;
+            film->metadata["head_pose"] = pose_text;  // px,py,pz,qw,qx,qy,qz
+        }
+
+        char suffix[32];
+        std::snprintf(suffix, sizeof suffix, "_%04d", k);
+        fs::path exr = base + suffix + ".exr", png = base + suffix + ".png";
+        write_exr_stereo(exr, frame.left, frame.right);
+        write_png_side_by_side(png, frame.left, frame.right, request.exposure);
+        written.push_back(exr.string());
+        written.push_back(png.string());
+        csv << k << "," << format_number(t, 6) << "," << pose_text << "," << format_number(frame.render_ms, 3) << "\n";
+        std::cout << "frame " << (k + 1) << "/" << plan.frames << "  t = " << format_number(t, 4) << " s  render "
+                  << format_number(frame.render_ms, 1) << " ms  " << exr.string() << std::endl;
+    }
+    write_file_atomically(csv_path, csv.str());
+    written.push_back(csv_path.string());
+    std::cout << "rendered " << scene.name << " with " << technique.name() << " (2 eyes, " << rig.preset().width
+              << "×" << rig.preset().height << "), " << plan.frames << " frames along " << plan.path << " in "
+              << format_number(total_ms / 1000.0, 3) << " s\n  " << csv_path.string() << "\n";
+    return written;
+}
+
 }  // namespace
 
 std::vector<std::string> run_render(const RenderRequest& request) {
@@ -56,6 +172,7 @@ std::vector<std::string> run_render(const RenderRequest& request) {
     if (request.hmd) rig = HmdRig(find_hmd_preset(*request.hmd));  // before loading: bad preset fails fast
     if (request.width && request.height) check_resolution(*request.width, *request.height);
     else if (request.width || request.height) throw Error("--width/--height", "give both or neither");
+    std::optional<TracePlan> plan = plan_trace(request);  // a bad trace fails before the scene loads
 
     OpenedScene opened = open_scene(request.scene, request.assets);
     for (const auto& w : opened.warnings) std::cerr << "gilab: note: " << request.scene << ": " << w << "\n";
@@ -78,23 +195,17 @@ std::vector<std::string> run_render(const RenderRequest& request) {
 
     technique->prepare(scene, settings);
     settings.report_unused();
+    if (plan) return render_sequence(*plan, *technique, *rig, scene, settings, request);
+
     if (request.time != 0) technique->update(request.time);
     std::vector<Film> films(views.views.size());
     technique->render(views, films);
 
-    for (size_t i = 0; i < films.size(); ++i) {
-        films[i].metadata["scene"] = scene.source.empty() ? scene.name : scene.source;
-        films[i].metadata["view"] = views.names[i];
-        films[i].metadata["technique"] = technique->name();
-        films[i].metadata["config_hash"] = settings.hash();
-        films[i].metadata["settings"] = settings.json().dump();
-        films[i].metadata["git_revision"] = git_revision();
-        films[i].metadata["seed"] = std::to_string(request.seed);
-        if (rig) films[i].metadata["hmd"] = rig->preset().name;
-    }
+    for (size_t i = 0; i < films.size(); ++i)
+        tag_film(films[i], scene, views.names[i], *technique, settings, request, rig ? &*rig : nullptr);
 
     std::string base = request.output;
-    if (base.empty()) base = "results/render/" + scene.name + "_" + technique->name() + (rig ? "_stereo" : "");
+    if (base.empty()) base = default_output(scene, *technique, rig.has_value());
     fs::path exr = base + ".exr", png = base + ".png";
     if (exr.has_parent_path()) fs::create_directories(exr.parent_path());
     if (films.size() == 2) {

@@ -20,10 +20,17 @@ struct RenderRequest {
     std::optional<std::string> settings_file;
     std::vector<std::string> assignments;  // key=value
     float exposure = 0;
+    // Head-pose trace (needs hmd): renders a sequence, frame k at t = k / fps, the head
+    // moving from the scene's HMD pose as the trace moves from its first sample.
+    std::optional<std::string> head_trace;
+    std::optional<int> frames;         // default: trace duration × fps, at least 1
+    std::optional<double> fps;        // default 30
+    std::optional<float> trace_scale;  // scene units per trace metre; default 1
     AssetPaths assets;
 };
 
-// Renders and writes OUTPUT.exr and OUTPUT.png; returns the paths written.
+// Renders and writes OUTPUT.exr and OUTPUT.png; returns the paths written. With a head
+// trace: OUTPUT_0000.exr/.png per frame and OUTPUT_frames.csv (head pose, render time).
 std::vector<std::string> run_render(const RenderRequest& request);
 
 // `gilab info`: a human-readable summary of a scene.

@@ -1,10 +1,15 @@
 // End-to-end checks of the `gilab` binary: good runs write their files, bad input gives
 // a clear message, a non-zero exit and no output files.
 #include <gtest/gtest.h>
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 #include <nlohmann/json.hpp>
+#include "core/film.hpp"
+#include "core/image_io.hpp"
 #include "tests/test_support.hpp"
 
 namespace fs = std::filesystem;
@@ -100,6 +105,110 @@ TEST(Cli, BadInputGivesAClearErrorAndNoFiles) {
     }
     expect_failure("render " + (dir / "empty.obj").string() + out, {"empty.obj"}, out_dir);
     expect_failure("experiment no_such_experiment --results " + out_dir.string(), {"no_such_experiment", "core-rays"},
+                   out_dir);
+}
+
+namespace {
+
+std::string head_turn_trace() { return std::string(GILAB_SOURCE_DIR) + "/scenes/traces/head_turn.csv"; }
+
+std::vector<std::string> read_lines(const fs::path& path) {
+    std::ifstream in(path);
+    std::vector<std::string> lines;
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+    return lines;
+}
+
+std::vector<double> csv_numbers(const std::string& line) {
+    std::vector<double> values;
+    std::istringstream in(line);
+    for (std::string field; std::getline(in, field, ',');) values.push_back(std::stod(field));
+    return values;
+}
+
+const std::vector<float>& color_of(const gilab::Film& film) { return film.layer("color").data; }
+
+}  // namespace
+
+TEST(Cli, HeadTraceRendersAStereoSequence) {
+    fs::path dir = gilab::test::temp_dir("cli_head_trace");
+    const std::string size = " --spp 1 -W 20 -H 22";
+    Result r = run("render cornell --hmd vive --head-trace " + head_turn_trace() + " --frames 3 --fps 30" + size +
+                   " -o " + (dir / "seq").string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    for (const char* frame : {"0000", "0001", "0002"}) {
+        EXPECT_TRUE(fs::exists(dir / ("seq_" + std::string(frame) + ".exr"))) << frame;
+        EXPECT_TRUE(fs::exists(dir / ("seq_" + std::string(frame) + ".png"))) << frame;
+    }
+    EXPECT_TRUE(fs::exists(dir / "seq_frames.csv"));
+    EXPECT_EQ(file_count(dir), 7u);  // three frames, the CSV, no temporaries
+    for (const char* line : {"frame 1/3", "frame 2/3", "frame 3/3"}) EXPECT_TRUE(contains(r.output, line)) << r.output;
+
+    auto lines = read_lines(dir / "seq_frames.csv");
+    ASSERT_EQ(lines.size(), 4u);
+    EXPECT_EQ(lines[0], "frame,time,px,py,pz,qw,qx,qy,qz,render_ms");
+    for (int k = 0; k < 3; ++k) {
+        auto row = csv_numbers(lines[size_t(k) + 1]);
+        ASSERT_EQ(row.size(), 10u) << lines[size_t(k) + 1];
+        EXPECT_EQ(row[0], k);
+        EXPECT_NEAR(row[1], k / 30.0, 1e-6);
+        EXPECT_NEAR(row[5] * row[5] + row[6] * row[6] + row[7] * row[7] + row[8] * row[8], 1.0, 1e-5);
+        EXPECT_GE(row[9], 0.0);
+    }
+
+    // Both eyes of each frame are in one multi-view EXR; the head moves, so frames differ.
+    gilab::Film first = gilab::read_exr(dir / "seq_0000.exr");
+    gilab::Film first_right = gilab::read_exr(dir / "seq_0000.exr", "right");
+    gilab::Film last = gilab::read_exr(dir / "seq_0002.exr");
+    ASSERT_EQ(first.width(), 20);
+    ASSERT_EQ(first.height(), 22);
+    EXPECT_NE(color_of(first), color_of(last));
+    EXPECT_NE(color_of(first), color_of(first_right));
+    EXPECT_EQ(first.metadata["frame"], "0");
+    EXPECT_EQ(last.metadata["frame"], "2");
+
+    // Frame 0 is the scene's own HMD pose: the same image as a plain stereo render.
+    Result still = run("render cornell --hmd vive" + size + " -o " + (dir / "still").string());
+    ASSERT_EQ(still.exit_code, 0) << still.output;
+    EXPECT_EQ(color_of(gilab::read_exr(dir / "still.exr")), color_of(first));
+    EXPECT_EQ(color_of(gilab::read_exr(dir / "still.exr", "right")), color_of(first_right));
+}
+
+TEST(Cli, TraceScaleZeroKeepsTheHeadInPlaceButTurnsIt) {
+    fs::path dir = gilab::test::temp_dir("cli_head_trace_scale");
+    Result r = run("render cornell --hmd vive --head-trace " + head_turn_trace() +
+                   " --frames 2 --fps 1 --trace-scale 0 --spp 1 -W 8 -H 8 -o " + (dir / "turn").string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    auto lines = read_lines(dir / "turn_frames.csv");
+    ASSERT_EQ(lines.size(), 3u);
+    auto a = csv_numbers(lines[1]), b = csv_numbers(lines[2]);
+    ASSERT_EQ(a.size(), 10u);
+    ASSERT_EQ(b.size(), 10u);
+    EXPECT_NEAR(b[1], 1.0, 1e-9);
+    for (int i = 2; i < 5; ++i) EXPECT_EQ(a[size_t(i)], b[size_t(i)]) << "position column " << i;
+    // One second into the trace the head has turned by about 15 degrees.
+    double dot = std::abs(a[5] * b[5] + a[6] * b[6] + a[7] * b[7] + a[8] * b[8]);
+    double degrees = 2.0 * std::acos(std::min(1.0, dot)) * 180.0 / 3.14159265358979;
+    EXPECT_GT(degrees, 14.0);
+    EXPECT_LT(degrees, 17.0);
+}
+
+TEST(Cli, BadHeadTraceOptionsGiveAClearErrorAndNoFiles) {
+    fs::path dir = gilab::test::temp_dir("cli_head_trace_errors");
+    fs::path out_dir = dir / "out";
+    fs::create_directories(out_dir);
+    std::string out = " --spp 1 -W 8 -H 8 -o " + (out_dir / "seq").string();
+    expect_failure("render cornell --head-trace " + head_turn_trace() + out, {"--head-trace", "--hmd"}, out_dir);
+    expect_failure("render cornell --hmd vive --head-trace " + (dir / "missing_trace.csv").string() + out,
+                   {"missing_trace.csv", "cannot open"}, out_dir);
+    fs::path bad = gilab::test::write_file(dir, "bad_trace.csv",
+                                           "t,px,py,pz,qw,qx,qy,qz\n0,0,1.6,0,1,0,0,0\n0.1,0,oops,0,1,0,0,0\n");
+    expect_failure("render cornell --hmd vive --head-trace " + bad.string() + out,
+                   {"bad_trace.csv:3", "'py' is not a number"}, out_dir);
+    expect_failure("render cornell --hmd vive --frames 3" + out, {"--frames", "--head-trace"}, out_dir);
+    expect_failure("render cornell --hmd vive --head-trace " + head_turn_trace() + " --fps 0" + out, {"--fps"},
+                   out_dir);
+    expect_failure("render cornell --hmd vive --head-trace " + head_turn_trace() + " --frames 0" + out, {"--frames"},
                    out_dir);
 }
 

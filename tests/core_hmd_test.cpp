@@ -1,8 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <functional>
 #include <string>
+#include <vector>
 #include "core/error.hpp"
 #include "core/hmd.hpp"
 #include "tests/test_support.hpp"
@@ -175,6 +178,92 @@ TEST(HeadPoseTrace, ExampleTraceInTheRepository) {
                                            trace[i].pose.orientation, trace[i - 1].pose.orientation)))));
         EXPECT_LT(angle, 2.0f);
     }
+}
+
+Quat yaw(float degrees) { return glm::angleAxis(glm::radians(degrees), Vec3(0, 1, 0)); }
+
+// Angle in degrees between two orientations (q and -q are the same rotation); atan2 stays
+// accurate for tiny angles, where acos of a dot product near 1 does not.
+float angle_between(const Quat& a, const Quat& b) {
+    Quat d = glm::conjugate(a) * b;
+    return glm::degrees(2.0f * std::atan2(glm::length(Vec3(d.x, d.y, d.z)), std::abs(d.w)));
+}
+
+HeadPoseSample sample_at(double time, Vec3 position, Quat orientation) {
+    HeadPoseSample s;
+    s.time = time;
+    s.pose.position = position;
+    s.pose.orientation = orientation;
+    return s;
+}
+
+TEST(TraceRelativePose, IdentityAtTheFirstSample) {
+    // The trace starts away from the origin, turned and at a non-zero time: none of it shows.
+    std::vector<HeadPoseSample> trace = {
+        sample_at(0.5, Vec3(1, 2, 3), glm::angleAxis(glm::radians(30.0f), glm::normalize(Vec3(1, 2, 0.5f)))),
+        sample_at(1.5, Vec3(4, 0, -1), yaw(-70.0f)),
+    };
+    HeadPose base{Vec3(5, -1, 2), glm::angleAxis(glm::radians(140.0f), glm::normalize(Vec3(0.3f, 1, -0.2f)))};
+    for (double t : {0.5, 0.0, -3.0}) {  // before the trace starts it is clamped to its first sample
+        HeadPose pose = trace_pose_relative_to(base, trace, t);
+        EXPECT_EQ(pose.position, base.position) << t;
+        EXPECT_EQ(pose.orientation, base.orientation) << t;
+    }
+    // Just after the first sample the pose is still (continuously) close to the base.
+    HeadPose soon = trace_pose_relative_to(base, trace, 0.5 + 1e-6);
+    EXPECT_LT(glm::length(soon.position - base.position), 1e-4f);
+    EXPECT_LT(angle_between(soon.orientation, base.orientation), 0.05f);
+    // Later in the trace the pose does change.
+    HeadPose later = trace_pose_relative_to(base, trace, 1.5);
+    EXPECT_GT(glm::length(later.position - base.position), 1.0f);
+    EXPECT_GT(angle_between(later.orientation, base.orientation), 10.0f);
+}
+
+TEST(TraceRelativePose, PureYawTurnsTheBaseByTheSameAngle) {
+    std::vector<HeadPoseSample> trace = {
+        sample_at(0, Vec3(0, 1.6f, 0), yaw(10.0f)),
+        sample_at(1, Vec3(0, 1.6f, 0), yaw(40.0f)),
+    };
+    // A base turned 180 degrees and pitched down: the 30 degree yaw is about the head's own up.
+    Quat base_orientation = yaw(180.0f) * glm::angleAxis(glm::radians(-20.0f), Vec3(1, 0, 0));
+    HeadPose base{Vec3(0.5f, 0.3f, -1.8f), base_orientation};
+    HeadPose end = trace_pose_relative_to(base, trace, 1.0);
+    EXPECT_LT(angle_between(end.orientation, base_orientation * yaw(30.0f)), 0.05f);
+    EXPECT_NEAR(angle_between(end.orientation, base_orientation), 30.0f, 0.05f);
+    EXPECT_LT(glm::length(end.position - base.position), 1e-6f);  // the trace did not move
+    HeadPose mid = trace_pose_relative_to(base, trace, 0.5);
+    EXPECT_LT(angle_between(mid.orientation, base_orientation * yaw(15.0f)), 0.05f);
+    EXPECT_NEAR(glm::length(end.orientation), 1.0f, 1e-6f);
+}
+
+TEST(TraceRelativePose, TranslationIsExpressedInTheBaseFrameAndScaled) {
+    // In tracking space the head faces -X (yawed 90 degrees) and steps 0.2 m forward, along
+    // -X; the base faces +Z, so in the scene the head steps 0.2 along +Z.
+    std::vector<HeadPoseSample> trace = {
+        sample_at(0, Vec3(3, 1.7f, 2), yaw(90.0f)),
+        sample_at(2, Vec3(2.8f, 1.7f, 2), yaw(90.0f)),
+    };
+    HeadPose base{Vec3(1, 1, 1), yaw(180.0f)};
+    HeadPose moved = trace_pose_relative_to(base, trace, 2.0);
+    EXPECT_LT(glm::length(moved.position - Vec3(1, 1, 1.2f)), 1e-5f);
+    EXPECT_LT(angle_between(moved.orientation, base.orientation), 0.05f);
+    // Scale converts trace metres into scene units: 2.5 units per metre, or none at all.
+    EXPECT_LT(glm::length(trace_pose_relative_to(base, trace, 2.0, 2.5f).position - Vec3(1, 1, 1.5f)), 1e-5f);
+    EXPECT_LT(glm::length(trace_pose_relative_to(base, trace, 1.0, 0.5f).position - Vec3(1, 1, 1.05f)), 1e-5f);
+    EXPECT_LT(glm::length(trace_pose_relative_to(base, trace, 2.0, 0.0f).position - base.position), 1e-6f);
+    // A sideways step to the head's right stays a step to the right of the base.
+    std::vector<HeadPoseSample> right = {
+        sample_at(0, Vec3(0), yaw(90.0f)),
+        sample_at(1, yaw(90.0f) * Vec3(0.1f, 0, 0), yaw(90.0f)),
+    };
+    HeadPose stepped = trace_pose_relative_to(base, right, 1.0);
+    EXPECT_LT(glm::length(stepped.position - (base.position + base.orientation * Vec3(0.1f, 0, 0))), 1e-5f);
+    EXPECT_LT(glm::length(stepped.position - Vec3(0.9f, 1, 1)), 1e-5f);
+}
+
+TEST(TraceRelativePose, EmptyTraceIsAnError) {
+    std::string message = error_of([] { trace_pose_relative_to(HeadPose{}, {}, 0.0); });
+    EXPECT_NE(message.find("empty head-pose trace"), std::string::npos) << message;
 }
 
 }  // namespace

@@ -21,6 +21,20 @@ TEST(ImageMetrics, IdenticalImagesHaveZeroError) {
     EXPECT_EQ(max_abs_difference(a, a), 0.0);
 }
 
+TEST(ImageMetrics, MaskedRelativeMseCountsOnlyMaskedPixels) {
+    Film ref = constant(4, 4, 1.0f), img = constant(4, 4, 1.0f);
+    img.set("color", 1, 2, Vec3(1.1f));  // pixel 9
+    std::vector<uint8_t> mask(16, 0);
+    EXPECT_EQ(relative_mse_masked(img, ref, mask), 0.0);  // nothing selected
+    mask[9] = 1;
+    EXPECT_NEAR(relative_mse_masked(img, ref, mask), 0.01 / 1.01, 1e-6);
+    mask[0] = 1;  // an exact pixel halves the mean
+    EXPECT_NEAR(relative_mse_masked(img, ref, mask), 0.5 * 0.01 / 1.01, 1e-6);
+    std::fill(mask.begin(), mask.end(), 1);
+    EXPECT_NEAR(relative_mse_masked(img, ref, mask), relative_mse(img, ref), 1e-12);
+    EXPECT_THROW(relative_mse_masked(img, ref, std::vector<uint8_t>(3, 1)), Error);
+}
+
 TEST(ImageMetrics, RelativeMseMatchesTheDefinition) {
     Film ref = constant(4, 4, 1.0f);
     Film img = constant(4, 4, 1.1f);

@@ -23,7 +23,7 @@
 // (no binocular rivalry from independent noise) and the stereo-reuse error below measures
 // geometry, not noise. stereo_reuse (false) fills right-eye pixels from the left eye's
 // hits (stereo_reuse.hpp); stereo_match (nearest: the paper's claim | strict: only where
-// the right pixel's own ray hits the same point within stereo_tolerance (0.25) pixel
+// the right pixel's own ray hits the same point within stereo_tolerance (0.5) pixel
 // footprints), stereo_reshade (true: re-evaluate the glossy lobe for the right eye;
 // false: copy the left colour, the paper's behaviour). The right film gets a "reused"
 // layer (1 where the pixel came from the left eye).

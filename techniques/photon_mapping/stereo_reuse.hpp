@@ -33,7 +33,7 @@ enum class StereoMatch { Nearest, Strict };
 struct StereoReuseSettings {
     bool enabled = false;
     StereoMatch match = StereoMatch::Nearest;
-    float tolerance = 0.25f;  // strict mode: allowed distance in right-eye pixel footprints
+    float tolerance = 0.5f;   // strict mode: allowed distance in right-eye pixel footprints
     bool reshade = true;      // re-evaluate the glossy lobe for the right eye's direction
 };
 

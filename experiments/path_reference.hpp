@@ -1,0 +1,18 @@
+#pragma once
+// The path-traced reference the photon experiments compare against: pixel centres (as
+// the photon technique renders), max depth 8, cached by its settings in the experiment's
+// directory or copied from a sibling pm-* directory that already rendered it.
+#include <string>
+#include <vector>
+#include "core/camera.hpp"
+#include "core/film.hpp"
+#include "core/scene.hpp"
+#include "experiments/experiment.hpp"
+
+namespace gilab {
+
+// Adds the reference's file name to `files`.
+Film path_reference(const ExperimentContext& ctx, const Scene& scene, const EyeCamera& camera, int spp,
+                    std::vector<std::string>& files);
+
+}  // namespace gilab
