@@ -115,13 +115,15 @@ double pixels_off_5pct(const Film& image, const Film& reference) {
     return double(off) / double(image.pixel_count());
 }
 
-std::vector<uint8_t> eccentricity_mask(const EyeCamera& eye, float degrees, bool inside) {
+// Pixels in full-rate gather blocks (inside = true) or in coarser ones.
+std::vector<uint8_t> fovea_mask(const EyeCamera& eye, float degrees, bool inside) {
+    FoveationSettings f;
+    f.enabled = true;
+    f.fovea_degrees = degrees;
     std::vector<uint8_t> mask(size_t(eye.width()) * size_t(eye.height()));
     for (int y = 0; y < eye.height(); ++y)
-        for (int x = 0; x < eye.width(); ++x) {
-            const bool in = eccentricity_degrees(eye, float(x) + 0.5f, float(y) + 0.5f) <= degrees;
-            mask[size_t(y) * size_t(eye.width()) + size_t(x)] = in == inside;
-        }
+        for (int x = 0; x < eye.width(); ++x)
+            mask[size_t(y) * size_t(eye.width()) + size_t(x)] = (foveated_block_size(eye, f, x, y) == 1) == inside;
     return mask;
 }
 
@@ -340,7 +342,7 @@ ExperimentOutput run_foveated(const ExperimentContext& ctx) {
     ResultTable t;
     t.title = "Foveated gather: left eye, time vs error inside and outside the fovea";
     t.columns = {"scene",          "fovea_angle",        "frame_ms",           "speedup",
-                 "shaded_fraction", "fovea_pixels",      "relmse_fovea_vs_full", "relmse_periphery_vs_full",
+                 "gather_fraction", "fovea_pixels",      "relmse_fovea_vs_full", "relmse_periphery_vs_full",
                  "relmse_fovea_vs_path", "relmse_periphery_vs_path"};
     for (const NamedScene& named : p1_scenes(ctx, out)) {
         const HmdRig rig = vive_rig(named.scene, ctx.quick);
@@ -361,10 +363,10 @@ ExperimentOutput run_foveated(const ExperimentContext& ctx) {
             r["fovea_angle"] = angle ? nlohmann::json(a) : nlohmann::json("off");
             r["frame_ms"] = run.stats.get("render_ms");
             r["speedup"] = runs[0].stats.get("render_ms") / run.stats.get("render_ms");
-            r["shaded_fraction"] = run.stats.get("shaded_samples") / pixels;
+            r["gather_fraction"] = run.stats.get("gather_queries") / pixels;
             if (angle) {
-                const std::vector<uint8_t> inside = eccentricity_mask(eye, a, true);
-                const std::vector<uint8_t> outside = eccentricity_mask(eye, a, false);
+                const std::vector<uint8_t> inside = fovea_mask(eye, a, true);
+                const std::vector<uint8_t> outside = fovea_mask(eye, a, false);
                 r["fovea_pixels"] = double(std::count(inside.begin(), inside.end(), 1)) / pixels;
                 r["relmse_fovea_vs_full"] = relative_mse_masked(run.films[0], runs[0].films[0], inside);
                 r["relmse_periphery_vs_full"] = relative_mse_masked(run.films[0], runs[0].films[0], outside);
@@ -390,12 +392,15 @@ ExperimentOutput run_foveated(const ExperimentContext& ctx) {
     out.config["radius"] = radius;
     out.config["periphery_photon_stride"] = 4;
     out.config["frames"] = frames;
-    out.notes.push_back("Not in the paper (its future work). Within fovea_angle of the gaze (the eye's forward axis) "
-                        "every pixel is shaded with all photons; up to twice the angle one sample per 2×2 block, beyond "
-                        "it one per 4×4, both over a map of every 4th photon with 4× the flux. *_vs_full compares with "
-                        "the unfoveated render (same seed; inside the fovea it is identical by construction); *_vs_path "
-                        "with the path-traced reference, i.e. the error a viewer would see.");
-    out.notes.push_back("fovea_pixels = share of pixels within the angle; shaded_fraction = shading samples ÷ pixels.");
+    out.notes.push_back("Not in the paper (its future work). Every pixel traces its own primary and shadow rays; "
+                        "photons are gathered at every pixel of the 4×4 blocks whose centre lies within fovea_angle of "
+                        "the gaze (the eye's forward axis), once per 2×2 block up to twice the angle and once per 4×4 "
+                        "beyond, over a map of every 4th photon with 4× the flux; a block's other pixels take that "
+                        "indirect light when they see the same surface nearby (else they gather themselves).");
+    out.notes.push_back("fovea = pixels of full-rate blocks (fovea_pixels: their share); gather_fraction = photon "
+                        "gathers ÷ pixels. *_vs_full compares with the unfoveated render of the same seed (the fovea "
+                        "is identical by construction, so its figure is 0); *_vs_path with the path-traced "
+                        "reference, the error a viewer would see.");
     return out;
 }
 

@@ -349,40 +349,42 @@ TEST(StereoReuse, IdenticalAtAnyThreadCount) {
     }
 }
 
-TEST(Foveation, FoveaIsUntouchedAndThePeripheryIsShadedCoarsely) {
+TEST(Foveation, FoveaIsUntouchedAndThePeripheryGathersLess) {
     Scene scene = make_cornell_box();
     HmdRig rig(find_hmd_preset("vive"), scene.hmd->pose);
-    rig.set_resolution(96, 104);
+    rig.set_resolution(192, 208);
     const EyeCamera eye = rig.eye(Eye::Left);
+    const nlohmann::json base = with(kBase, {{"radius", 0.1}});
     Stats full_stats, foveated_stats;
-    const Film full = render_views(scene, ViewSet::mono(eye), kBase, &full_stats).at(0);
-    const nlohmann::json fov = with(kBase, {{"foveated", true}, {"fovea_angle", 12}});
+    const Film full = render_views(scene, ViewSet::mono(eye), base, &full_stats).at(0);
+    FoveationSettings fovea;
+    fovea.enabled = true;
+    fovea.fovea_degrees = 12;
+    const nlohmann::json fov = with(base, {{"foveated", true}, {"fovea_angle", 12}});
     const Film foveated = render_views(scene, ViewSet::mono(eye), fov, &foveated_stats).at(0);
-    size_t inside = 0, outside_differs = 0, outside = 0;
+    size_t inside = 0, outside = 0, outside_differs = 0;
     for (int y = 0; y < eye.height(); ++y)
         for (int x = 0; x < eye.width(); ++x) {
-            // Blocks are 4×4: a pixel is surely in a full-rate block when its block's
-            // centre is inside the fovea.
-            const float bx = float(x / 4 * 4) + 2.0f, by = float(y / 4 * 4) + 2.0f;
-            const float e = eccentricity_degrees(eye, bx, by);
-            const Vec3 a = foveated.get("color", x, y), b = full.get("color", x, y);
-            if (e <= 12.0f) {
+            // Direct light is traced per pixel everywhere.
+            EXPECT_EQ(foveated.get("direct", x, y), full.get("direct", x, y)) << "pixel " << x << "," << y;
+            const Vec3 a = foveated.get("indirect", x, y), b = full.get("indirect", x, y);
+            const int block = foveated_block_size(eye, fovea, x, y);
+            if (block == 1) {
                 ++inside;
                 EXPECT_EQ(a, b) << "pixel " << x << "," << y << " inside the fovea";
-            } else if (e > 24.0f) {
+            } else if (block == 4) {
                 ++outside;
                 outside_differs += a != b;
-                EXPECT_EQ(a, foveated.get("color", x / 4 * 4, y / 4 * 4)) << "4×4 block at " << x << "," << y;
             }
         }
-    EXPECT_GT(inside, 150u);
-    EXPECT_GT(outside, 3000u);
+    EXPECT_GT(inside, 600u);
+    EXPECT_GT(outside, 12000u);
     EXPECT_GT(outside_differs, outside / 2);
-    EXPECT_LT(foveated_stats.get("shaded_samples"), 0.5 * full_stats.get("shaded_samples"));
-    EXPECT_LT(relative_mse(foveated, full, "color"), 0.5);
+    EXPECT_LT(foveated_stats.get("gather_queries"), 0.25 * full_stats.get("gather_queries"));
+    EXPECT_LT(relative_mse(foveated, full, "color"), 0.05);
 
     // A fovea wider than the field of view changes nothing.
-    const Film all = render_views(scene, ViewSet::mono(eye), with(kBase, {{"foveated", true}, {"fovea_angle", 170}})).at(0);
+    const Film all = render_views(scene, ViewSet::mono(eye), with(base, {{"foveated", true}, {"fovea_angle", 170}})).at(0);
     EXPECT_EQ(std::memcmp(all.layer("color").data.data(), full.layer("color").data.data(),
                           full.layer("color").data.size() * sizeof(float)),
               0);

@@ -10,9 +10,11 @@ float eccentricity_degrees(const EyeCamera& eye, float px, float py) {
     return std::acos(c) * (180.0f / kPi);
 }
 
-int foveated_block_size(const EyeCamera& eye, const FoveationSettings& settings, float px, float py) {
+int foveated_block_size(const EyeCamera& eye, const FoveationSettings& settings, int x, int y) {
     if (!settings.enabled) return 1;
-    const float e = eccentricity_degrees(eye, px, py);
+    const int x0 = x / 4 * 4, y0 = y / 4 * 4;
+    const int x1 = std::min(x0 + 4, eye.width()), y1 = std::min(y0 + 4, eye.height());
+    const float e = eccentricity_degrees(eye, 0.5f * float(x0 + x1), 0.5f * float(y0 + y1));
     if (e <= settings.fovea_degrees) return 1;
     return e <= 2.0f * settings.fovea_degrees ? 2 : 4;
 }

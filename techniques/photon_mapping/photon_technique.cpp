@@ -224,7 +224,7 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
     float* direct = film.layer("direct").data.data();
     float* indirect = film.layer("indirect").data.data();
     std::mutex merge;
-    std::atomic<uint64_t> nonfinite{0}, groups{0}, grouped_hits{0}, fetched{0}, shaded{0};
+    std::atomic<uint64_t> nonfinite{0}, groups{0}, grouped_hits{0}, fetched{0};
     KeptHits* keep = options.keep;
     if (keep) {
         keep->per_pixel = size_t(std::max(s.light_samples, 0));
@@ -318,35 +318,39 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
         }
         return items;
     };
-    // Foveated tile: 4×4 blocks, each shaded at the rate its eccentricity allows; a
-    // coarse sample (at its block's centre, with its top-left pixel's light stream and
-    // the periphery photon map) is copied to every pixel of its block.
+    // Foveated tile (foveation.hpp): every pixel traces its primary and shadow rays; in
+    // 2×2 and 4×4 gather blocks the first hit gathers (over the periphery map) and the
+    // block's other hits on the same surface nearby take its indirect light.
+    const float share_distance2 = s.radius * s.radius;
+    auto shares_gather = [&](const HitRecord& a, const HitRecord& b) {
+        return a.point.material == b.point.material && glm::dot(a.point.normal, b.point.normal) > 0.95f &&
+               glm::dot(a.point.position - b.point.position, a.point.position - b.point.position) < share_distance2;
+    };
     auto shade_foveated_tile = [&](const Tile& tile, GatherScratch& scratch, PhotonQueryStats& qs) {
-        uint64_t samples_taken = 0;
         for (int by = tile.y0; by < tile.y1; by += 4)
             for (int bx = tile.x0; bx < tile.x1; bx += 4) {
                 const int bx1 = std::min(bx + 4, tile.x1), by1 = std::min(by + 4, tile.y1);
-                const int b = foveated_block_size(camera, s.foveation, 0.5f * float(bx + bx1), 0.5f * float(by + by1));
+                const int b = foveated_block_size(camera, s.foveation, bx, by);
                 const PhotonGatherer& g = b == 1 ? gatherer : *periphery;
                 for (int sy = by; sy < by1; sy += b)
                     for (int sx = bx; sx < bx1; sx += b) {
-                        const int ex = std::min(sx + b, bx1), ey = std::min(sy + b, by1);
-                        const uint32_t rep = pixel_index(sx, sy);
-                        HitRecord rec = trace_pixel(0.5f * float(sx + ex), 0.5f * float(sy + ey), rep);
-                        write_indirect(rep, rec.valid ? g.estimate(rec.point, scratch, qs) : Vec3(0.0f));
-                        ++samples_taken;
-                        for (int y = sy; y < ey; ++y)
-                            for (int x = sx; x < ex; ++x) {
-                                const uint32_t p = pixel_index(x, y);
-                                if (p == rep) continue;
-                                for (int c = 0; c < 3; ++c) {
-                                    direct[3 * size_t(p) + size_t(c)] = direct[3 * size_t(rep) + size_t(c)];
-                                    indirect[3 * size_t(p) + size_t(c)] = indirect[3 * size_t(rep) + size_t(c)];
+                        std::optional<HitRecord> gathered;
+                        Vec3 gathered_light(0.0f);
+                        for (int y = sy; y < std::min(sy + b, by1); ++y)
+                            for (int x = sx; x < std::min(sx + b, bx1); ++x) {
+                                HitRecord rec = trace_pixel(float(x) + 0.5f, float(y) + 0.5f, pixel_index(x, y));
+                                if (!rec.valid) {
+                                    write_indirect(rec.pixel, Vec3(0.0f));
+                                } else if (gathered && shares_gather(*gathered, rec)) {
+                                    write_indirect(rec.pixel, gathered_light);
+                                } else {
+                                    const Vec3 v = g.estimate(rec.point, scratch, qs);
+                                    write_indirect(rec.pixel, v);
+                                    if (!gathered) gathered = rec, gathered_light = v;
                                 }
                             }
                     }
             }
-        shaded += samples_taken;
     };
 
     if (!s.split) {
@@ -362,7 +366,6 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
                         HitRecord rec = trace_pixel(float(x) + 0.5f, float(y) + 0.5f, pixel_index(x, y));
                         write_indirect(rec.pixel, rec.valid ? gatherer.estimate(rec.point, scratch, qs) : Vec3(0.0f));
                     }
-                shaded += uint64_t(tile.x1 - tile.x0) * uint64_t(tile.y1 - tile.y0);
             } else {
                 // Trace the tile, then group its hits by cell.
                 std::vector<HitRecord> tile_hits;
@@ -378,7 +381,6 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
                     }
                 std::vector<SortItem> items = sort_items(tile_hits, valid);
                 gather_sorted(tile_hits, items, 0, items.size(), scratch, qs, true);
-                shaded += tile_hits.size();
             }
             fetched += scratch.fetched;
             std::lock_guard<std::mutex> lock(merge);
@@ -396,7 +398,6 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
                     hits[rec.pixel] = rec;
                 }
         });
-        shaded += hits.size();
         frame_stats.add("trace_pass_ms", trace_watch.elapsed_ms());
         // Pass 2: gather in cell order for memory coherence, results written by pixel.
         Stopwatch sort_watch;
@@ -439,7 +440,6 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
     frame_stats.add("tile_groups", double(groups.load()));
     frame_stats.add("tile_grouped_hits", double(grouped_hits.load()));
     frame_stats.add("tile_fetched_photons", double(fetched.load()));
-    frame_stats.add("shaded_samples", double(shaded.load()));
 }
 
 void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const EyeCamera& right, const KeptHits& kept,
@@ -598,7 +598,7 @@ void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& fil
     for (Film& film : films) film.metadata["render_time_seconds"] = number(ms / 1000.0);
     // Per-frame figures replace the previous frame's.
     for (const char* key : {"fused_ms", "trace_pass_ms", "sort_ms", "gather_pass_ms", "nonfinite_pixels", "tile_groups",
-                            "tile_grouped_hits", "tile_fetched_photons", "shaded_samples", "left_ms", "right_ms",
+                            "tile_grouped_hits", "tile_fetched_photons", "left_ms", "right_ms",
                             "claim_ms", "right_pass_ms", "reuse_left_hits", "reuse_back_side", "reuse_outside",
                             "reuse_occluded", "reuse_candidates", "reuse_claimed_pixels", "reuse_depth_conflicts",
                             "reuse_strict_rejected", "reused_pixels", "reuse_fraction", "reuse_reshaded_glossy",
