@@ -73,6 +73,9 @@ struct PhotonMappingTechnique::ViewOptions {
     KeptHits* keep = nullptr;                // keep every hit (left eye of a reusing stereo render)
 };
 
+PhotonMappingTechnique::PhotonMappingTechnique() = default;
+PhotonMappingTechnique::~PhotonMappingTechnique() = default;
+
 PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     PhotonMappingSettings p;
     const std::string& where = s.context();
@@ -227,9 +230,10 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
     std::atomic<uint64_t> nonfinite{0}, groups{0}, grouped_hits{0}, fetched{0};
     KeptHits* keep = options.keep;
     if (keep) {
+        // Kept from frame to frame: every pixel overwrites its entry, so no clearing.
         keep->per_pixel = size_t(std::max(s.light_samples, 0));
-        keep->hits.assign(film.pixel_count(), PrimaryHit{});
-        keep->samples.assign(film.pixel_count() * keep->per_pixel, LightSampleRecord{});
+        keep->hits.resize(film.pixel_count());
+        keep->samples.resize(film.pixel_count() * keep->per_pixel);
     }
 
     // The light-sample stream of a hit: its own pixel's, or in a stereo right eye the
@@ -266,6 +270,8 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
             rec.point = ph.point;
             rec.valid = true;
             if (keep) keep->hits[pixel] = ph;
+        } else if (keep) {
+            keep->hits[pixel].valid = false;
         }
         write_pixel(direct, pixel, finite_or_zero(L, nonfinite));
         return rec;
@@ -563,7 +569,7 @@ void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& fil
     Stats frame;
     const bool stereo = views.stereo();
     const bool reuse = stereo && settings_.stereo.enabled;
-    KeptHits kept;
+    if (reuse && !kept_) kept_ = std::make_unique<KeptHits>();
     for (size_t v = 0; v < views.views.size(); ++v) {
         const EyeCamera& camera = views.views[v];
         check_resolution(camera.width(), camera.height(), 4);
@@ -572,12 +578,12 @@ void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& fil
         film.add_layer("indirect");
         Stopwatch view_watch;
         if (reuse && v == 1) {
-            render_right_reusing(views.views[0], camera, kept, films[0], film, queries, frame);
+            render_right_reusing(views.views[0], camera, *kept_, films[0], film, queries, frame);
         } else {
             ViewOptions options;
             options.view = v;
             if (stereo && v == 1) options.stream_eye = &views.views[0];
-            if (reuse && v == 0) options.keep = &kept;
+            if (reuse && v == 0) options.keep = kept_.get();
             render_view(camera, options, film, queries, frame);
         }
         const double view_ms = view_watch.elapsed_ms();

@@ -70,6 +70,8 @@ struct PhotonMappingSettings {
 
 class PhotonMappingTechnique final : public Technique {
 public:
+    PhotonMappingTechnique();
+    ~PhotonMappingTechnique() override;
     std::string name() const override { return "photon"; }
     void prepare(const Scene& scene, const Settings& settings) override;
     void update(double time) override;
@@ -93,6 +95,7 @@ private:
     TracedScene scene_;
     std::unique_ptr<PhotonMap> map_;
     std::unique_ptr<PhotonMap> periphery_map_;  // foveation: every stride-th photon
+    std::unique_ptr<KeptHits> kept_;            // stereo reuse: the left eye's hits, reused across frames
     Stats stats_;
 };
 

@@ -9,8 +9,6 @@ PrimaryHit primary_hit_of(const SurfaceInteraction& si, const Material& m) {
     out.valid = true;
     out.point = {si.position, si.shading_normal, si.wo, si.material};
     out.geometric_normal = si.geometric_normal;
-    out.triangle = si.triangle;
-    out.mesh = si.mesh;
     if (m.is_emissive() && !si.back_face) out.emitted = m.emission;
     return out;
 }

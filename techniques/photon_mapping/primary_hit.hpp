@@ -27,7 +27,6 @@ struct PrimaryHit {
     Vec3 geometric_normal{0};   // viewer side
     Vec3 emitted{0};            // emission towards the viewer (front faces only)
     Vec3 irradiance{0};         // Σ LightSampleRecord::weight: the Lambertian direct term / (ρ/π)
-    uint32_t triangle = kInvalidId, mesh = kInvalidId;
     uint16_t sample_count = 0;  // records at samples[pixel · light_samples ...]
     bool valid = false;
 };

@@ -50,10 +50,9 @@ StereoClaims::StereoClaims(const std::vector<PrimaryHit>& left_hits, const EyeCa
     const size_t right_pixels = size_t(right.width()) * size_t(right.height());
     std::vector<std::atomic<uint64_t>> nearest(right_pixels);
     std::vector<std::atomic<uint32_t>> farthest(right_pixels);
-    for (size_t i = 0; i < right_pixels; ++i) {
-        nearest[i].store(kUnclaimed, std::memory_order_relaxed);
-        farthest[i].store(0, std::memory_order_relaxed);
-    }
+    parallel_for(right_pixels, 1 << 16, [&](size_t begin, size_t end) {
+        for (size_t i = begin; i < end; ++i) nearest[i].store(kUnclaimed, std::memory_order_relaxed);
+    });
     const Reprojector reproject(right);
     const Vec3 left_eye = left.position(), right_eye = right.position();
     std::atomic<uint64_t> hits{0}, back_side{0}, outside{0}, occluded{0}, candidates{0};
@@ -109,18 +108,26 @@ StereoClaims::StereoClaims(const std::vector<PrimaryHit>& left_hits, const EyeCa
         hits += n_hits, back_side += n_back, outside += n_out, occluded += n_occ, candidates += n_cand;
     });
 
-    source_.assign(right_pixels, kNone);
-    uint64_t claimed = 0, conflicts = 0;
-    for (size_t i = 0; i < right_pixels; ++i) {
-        uint64_t key = nearest[i].load(std::memory_order_relaxed);
-        if (key == kUnclaimed) continue;
-        source_[i] = uint32_t(key & 0xffffffffu);
-        ++claimed;
-        float near = std::bit_cast<float>(uint32_t(key >> 32));
-        float far = std::bit_cast<float>(farthest[i].load(std::memory_order_relaxed));
-        if (far > near * 1.01f) ++conflicts;
-    }
-    stats_ = {hits.load(), back_side.load(), outside.load(), occluded.load(), candidates.load(), claimed, conflicts};
+    source_.resize(right_pixels);
+    std::atomic<uint64_t> claimed{0}, conflicts{0};
+    parallel_for(right_pixels, 1 << 16, [&](size_t begin, size_t end) {
+        uint64_t n_claimed = 0, n_conflicts = 0;
+        for (size_t i = begin; i < end; ++i) {
+            const uint64_t key = nearest[i].load(std::memory_order_relaxed);
+            if (key == kUnclaimed) {
+                source_[i] = kNone;
+                continue;
+            }
+            source_[i] = uint32_t(key & 0xffffffffu);
+            ++n_claimed;
+            const float near = std::bit_cast<float>(uint32_t(key >> 32));
+            const float far = std::bit_cast<float>(farthest[i].load(std::memory_order_relaxed));
+            n_conflicts += far > near * 1.01f;
+        }
+        claimed += n_claimed, conflicts += n_conflicts;
+    });
+    stats_ = {hits.load(), back_side.load(), outside.load(), occluded.load(), candidates.load(), claimed.load(),
+              conflicts.load()};
 }
 
 bool same_surface_point(const PrimaryHit& left_hit, const PrimaryHit& right_hit, const EyeCamera& right,
