@@ -390,6 +390,35 @@ TEST(Foveation, FoveaIsUntouchedAndThePeripheryGathersLess) {
               0);
 }
 
+TEST(Foveation, TheFoveaFollowsTheGaze) {
+    Scene scene = make_cornell_box();
+    HmdRig rig(find_hmd_preset("vive"), scene.hmd->pose);
+    rig.set_resolution(192, 208);
+    const EyeCamera eye = rig.eye(Eye::Left);
+    FoveationSettings f;
+    f.enabled = true;
+    f.fovea_degrees = 8;
+    f.gaze_yaw_degrees = 30;  // looking right: the fovea moves to the image's right half
+    double centre_x = 0;
+    size_t count = 0;
+    for (int y = 0; y < eye.height(); ++y)
+        for (int x = 0; x < eye.width(); ++x)
+            if (foveated_block_size(eye, f, x, y) == 1) centre_x += x, ++count;
+    ASSERT_GT(count, 100u);
+    const std::optional<Vec2> gaze_pixel = eye.project(eye.position() + gaze_direction(eye, f));
+    ASSERT_TRUE(gaze_pixel.has_value());
+    EXPECT_GT(gaze_pixel->x, 0.6f * float(eye.width()));
+    EXPECT_NEAR(centre_x / double(count), gaze_pixel->x, 4.0);
+    // The rendered fovea is where the setting puts it: full-rate pixels equal the full render.
+    const nlohmann::json base = with(kBase, {{"radius", 0.1}});
+    const Film full = render_views(scene, ViewSet::mono(eye), base).at(0);
+    const Film gazed =
+        render_views(scene, ViewSet::mono(eye), with(base, {{"foveated", true}, {"fovea_angle", 8}, {"gaze_yaw", 30}})).at(0);
+    for (int y = 0; y < eye.height(); ++y)
+        for (int x = 0; x < eye.width(); ++x)
+            if (foveated_block_size(eye, f, x, y) == 1) ASSERT_EQ(gazed.get("color", x, y), full.get("color", x, y));
+}
+
 TEST(StereoReuse, BadSettingsAreErrorsNamingTheKey) {
     Scene scene = make_cornell_box();
     auto error = [&](const nlohmann::json& s) {
@@ -406,6 +435,7 @@ TEST(StereoReuse, BadSettingsAreErrorsNamingTheKey) {
               std::string::npos);
     EXPECT_NE(error(with(kBase, {{"foveated", true}, {"pass", "split"}})).find("foveated"), std::string::npos);
     EXPECT_NE(error(with(kBase, {{"foveated", true}, {"tile_size", 6}})).find("tile_size"), std::string::npos);
+    EXPECT_NE(error(with(kBase, {{"foveated", true}, {"gaze_yaw", 120}})).find("gaze_yaw"), std::string::npos);
     EXPECT_NE(error(with(kBase, {{"foveated", true}, {"stereo_reuse", true}})).find("stereo_reuse"), std::string::npos);
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 // Foveated gather (P1's future work): the eye resolves detail only near the gaze
 // direction, so away from it the technique gathers photons less often and over fewer of
-// them. Eccentricity is the angle between a ray and the gaze (the eye's forward axis).
+// them. Eccentricity is the angle between a ray and the gaze: the eye's forward axis
+// turned by gaze_yaw (to the right) and gaze_pitch (up), as an eye tracker would report.
 // The image is cut into 4×4 blocks; a block whose centre lies within `fovea_degrees`
 // gathers at every pixel with the full photon map. Up to twice that angle it gathers once
 // per 2×2 block, beyond it once per 4×4 block, both over a map that keeps every
@@ -23,13 +24,18 @@ struct FoveationSettings {
     bool enabled = false;
     float fovea_degrees = 10.0f;
     int periphery_photon_stride = 4;
+    float gaze_yaw_degrees = 0.0f;    // gaze relative to the eye's forward axis
+    float gaze_pitch_degrees = 0.0f;
 };
+
+// World-space gaze direction of an eye.
+Vec3 gaze_direction(const EyeCamera& eye, const FoveationSettings& settings);
 
 // Gather block size (1, 2 or 4 pixels) of the 4×4 block (aligned to multiples of 4,
 // clipped to the image) that contains pixel (x, y).
 int foveated_block_size(const EyeCamera& eye, const FoveationSettings& settings, int x, int y);
 
-// Eccentricity in degrees of the ray through (px, py) from the eye's forward axis.
-float eccentricity_degrees(const EyeCamera& eye, float px, float py);
+// Eccentricity in degrees of the ray through (px, py) from the gaze.
+float eccentricity_degrees(const EyeCamera& eye, const FoveationSettings& settings, float px, float py);
 
 }  // namespace gilab

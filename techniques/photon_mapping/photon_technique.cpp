@@ -98,6 +98,8 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     p.foveation.enabled = s.get<bool>("foveated", p.foveation.enabled);
     p.foveation.fovea_degrees = s.get<float>("fovea_angle", p.foveation.fovea_degrees);
     p.foveation.periphery_photon_stride = s.get<int>("periphery_photon_stride", p.foveation.periphery_photon_stride);
+    p.foveation.gaze_yaw_degrees = s.get<float>("gaze_yaw", p.foveation.gaze_yaw_degrees);
+    p.foveation.gaze_pitch_degrees = s.get<float>("gaze_pitch", p.foveation.gaze_pitch_degrees);
 
     if (photons < 1) throw Error(where, "setting 'photons' must be at least 1, got " + std::to_string(photons));
     p.photons = uint64_t(photons);
@@ -141,6 +143,10 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
         const float angle = p.foveation.fovea_degrees;
         if (!(angle > 0.0f && angle < 180.0f))
             throw Error(where, "setting 'fovea_angle' must be in (0, 180) degrees, got " + number(angle));
+        for (auto [key, value] : {std::pair{"gaze_yaw", p.foveation.gaze_yaw_degrees},
+                                  std::pair{"gaze_pitch", p.foveation.gaze_pitch_degrees}})
+            if (!(std::abs(value) <= 90.0f))
+                throw Error(where, std::string("setting '") + key + "' must be within ±90 degrees, got " + number(value));
         if (p.foveation.periphery_photon_stride < 1)
             throw Error(where, "setting 'periphery_photon_stride' must be at least 1, got " +
                                    std::to_string(p.foveation.periphery_photon_stride));
