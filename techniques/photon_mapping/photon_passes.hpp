@@ -1,0 +1,40 @@
+#pragma once
+// Pieces the photon technique's passes share (photon_technique.cpp orchestrates,
+// photon_view_pass.cpp renders one eye, photon_stereo_pass.cpp the reusing right eye).
+#include <atomic>
+#include <span>
+#include <vector>
+#include "techniques/photon_mapping/photon_technique.hpp"
+#include "techniques/photon_mapping/primary_hit.hpp"
+
+namespace gilab {
+
+// The left eye's hits, kept for the right eye (stereo reuse).
+struct PhotonMappingTechnique::KeptHits {
+    std::vector<PrimaryHit> hits;              // one per left pixel
+    std::vector<LightSampleRecord> samples;    // light_samples per left pixel
+    size_t per_pixel = 0;
+    std::span<const LightSampleRecord> samples_of(size_t pixel) const {
+        return {samples.data() + pixel * per_pixel, per_pixel};
+    }
+};
+
+// What one view's render needs beyond its camera.
+struct PhotonMappingTechnique::ViewOptions {
+    uint64_t view = 0;                       // light-sample stream of pixels keyed by themselves
+    const EyeCamera* stream_eye = nullptr;   // stereo right eye: key by the left pixel seeing the point
+    KeptHits* keep = nullptr;                // keep every hit (left eye of a reusing stereo render)
+};
+
+// A non-finite radiance is counted and written as black.
+inline Vec3 finite_or_zero(const Vec3& v, std::atomic<uint64_t>& nonfinite) {
+    if (is_finite(v)) return v;
+    ++nonfinite;
+    return Vec3(0.0f);
+}
+
+inline void write_pixel(float* layer, size_t pixel, const Vec3& v) {
+    for (int c = 0; c < 3; ++c) layer[3 * pixel + size_t(c)] = v[c];
+}
+
+}  // namespace gilab

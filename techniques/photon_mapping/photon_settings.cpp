@@ -1,0 +1,104 @@
+#include <cmath>
+#include <sstream>
+#include "core/error.hpp"
+#include "techniques/photon_mapping/photon_technique.hpp"
+
+namespace gilab {
+
+namespace {
+
+std::string number(double v) {
+    std::ostringstream out;
+    out.precision(9);
+    out << v;
+    return out.str();
+}
+
+}  // namespace
+
+PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
+    PhotonMappingSettings p;
+    const std::string& where = s.context();
+    int64_t photons = s.get<int64_t>("photons", int64_t(p.photons));
+    p.radius = s.get<float>("radius", p.radius);
+    std::string gather = s.get<std::string>("gather", "radius");
+    p.k = s.get<int>("k", p.k);
+    std::string map = s.get<std::string>("photon_map", to_string(p.photon_map));
+    std::string hash_query = s.get<std::string>("hash_query", to_string(p.hash_query));
+    std::string pass = s.get<std::string>("pass", "fused");
+    p.tile_shared = s.get<bool>("tile_shared", p.tile_shared);
+    int64_t seed = s.get<int64_t>("seed", int64_t(p.seed));
+    p.light_samples = s.get<int>("light_samples", p.light_samples);
+    p.max_photon_depth = s.get<int>("max_photon_depth", p.max_photon_depth);
+    p.tile_size = s.get<int>("tile_size", p.tile_size);
+    p.stereo.enabled = s.get<bool>("stereo_reuse", p.stereo.enabled);
+    std::string match = s.get<std::string>("stereo_match", to_string(p.stereo.match));
+    p.stereo.tolerance = s.get<float>("stereo_tolerance", p.stereo.tolerance);
+    p.stereo.reshade = s.get<bool>("stereo_reshade", p.stereo.reshade);
+    p.foveation.enabled = s.get<bool>("foveated", p.foveation.enabled);
+    p.foveation.fovea_degrees = s.get<float>("fovea_angle", p.foveation.fovea_degrees);
+    p.foveation.periphery_photon_stride = s.get<int>("periphery_photon_stride", p.foveation.periphery_photon_stride);
+    p.foveation.gaze_yaw_degrees = s.get<float>("gaze_yaw", p.foveation.gaze_yaw_degrees);
+    p.foveation.gaze_pitch_degrees = s.get<float>("gaze_pitch", p.foveation.gaze_pitch_degrees);
+
+    if (photons < 1) throw Error(where, "setting 'photons' must be at least 1, got " + std::to_string(photons));
+    p.photons = uint64_t(photons);
+    if (!(p.radius > 0.0f) || !std::isfinite(p.radius))
+        throw Error(where, "setting 'radius' must be positive and finite, got " + number(p.radius));
+    if (gather == "radius")
+        p.gather = GatherMode::Radius;
+    else if (gather == "knn")
+        p.gather = GatherMode::Knn;
+    else
+        throw Error(where, "setting 'gather' must be 'radius' or 'knn', got '" + gather + "'");
+    if (p.k < 1) throw Error(where, "setting 'k' must be at least 1, got " + std::to_string(p.k));
+    p.photon_map = parse_photon_map_kind(map, where + ": setting 'photon_map'");
+    p.hash_query = parse_hash_query(hash_query, where + ": setting 'hash_query'");
+    if (pass == "fused")
+        p.split = false;
+    else if (pass == "split")
+        p.split = true;
+    else
+        throw Error(where, "setting 'pass' must be 'fused' or 'split', got '" + pass + "'");
+    if (p.tile_shared && p.photon_map != PhotonMapKind::HashGrid)
+        throw Error(where, "setting 'tile_shared' needs photon_map=hash_grid (it shares hash-grid cells), got " + map);
+    if (seed < 0) throw Error(where, "setting 'seed' must not be negative, got " + std::to_string(seed));
+    p.seed = uint64_t(seed);
+    if (p.light_samples < 0)
+        throw Error(where, "setting 'light_samples' must not be negative, got " + std::to_string(p.light_samples));
+    if (p.max_photon_depth < 1)
+        throw Error(where, "setting 'max_photon_depth' must be at least 1, got " + std::to_string(p.max_photon_depth));
+    if (p.tile_size < 1) throw Error(where, "setting 'tile_size' must be at least 1, got " + std::to_string(p.tile_size));
+    if (match == "nearest")
+        p.stereo.match = StereoMatch::Nearest;
+    else if (match == "strict")
+        p.stereo.match = StereoMatch::Strict;
+    else
+        throw Error(where, "setting 'stereo_match' must be 'nearest' or 'strict', got '" + match + "'");
+    if (!(p.stereo.tolerance >= 0.0f) || !std::isfinite(p.stereo.tolerance))
+        throw Error(where, "setting 'stereo_tolerance' must be a finite number of pixels ≥ 0, got " + number(p.stereo.tolerance));
+    if (p.light_samples > 0xffff)
+        throw Error(where, "setting 'light_samples' must be at most 65535, got " + std::to_string(p.light_samples));
+    if (p.foveation.enabled) {
+        const float angle = p.foveation.fovea_degrees;
+        if (!(angle > 0.0f && angle < 180.0f))
+            throw Error(where, "setting 'fovea_angle' must be in (0, 180) degrees, got " + number(angle));
+        for (auto [key, value] : {std::pair{"gaze_yaw", p.foveation.gaze_yaw_degrees},
+                                  std::pair{"gaze_pitch", p.foveation.gaze_pitch_degrees}})
+            if (!(std::abs(value) <= 90.0f))
+                throw Error(where, std::string("setting '") + key + "' must be within ±90 degrees, got " + number(value));
+        if (p.foveation.periphery_photon_stride < 1)
+            throw Error(where, "setting 'periphery_photon_stride' must be at least 1, got " +
+                                   std::to_string(p.foveation.periphery_photon_stride));
+        if (p.split || p.tile_shared)
+            throw Error(where, "setting 'foveated' needs pass=fused and tile_shared=false (it picks the shading rate per block)");
+        if (p.tile_size % 4 != 0)
+            throw Error(where, "setting 'foveated' needs a tile_size that is a multiple of 4 (4×4 shading blocks), got " +
+                                   std::to_string(p.tile_size));
+        if (p.stereo.enabled)
+            throw Error(where, "settings 'foveated' and 'stereo_reuse' cannot be combined yet");
+    }
+    return p;
+}
+
+}  // namespace gilab

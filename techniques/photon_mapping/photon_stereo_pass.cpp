@@ -1,0 +1,126 @@
+// The right eye of a reusing stereo render: claims by the left eye's hits
+// (stereo_reuse.hpp), then every right pixel either composes the claiming hit's
+// view-independent shading with its own glossy lobe, or is shaded as an independent eye.
+#include <mutex>
+#include <optional>
+#include "core/interaction.hpp"
+#include "core/parallel.hpp"
+#include "core/rng.hpp"
+#include "techniques/photon_mapping/photon_passes.hpp"
+
+namespace gilab {
+
+void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const EyeCamera& right, const KeptHits& kept,
+                                                  const Film& left_film, Film& film, PhotonQueryStats& query_stats,
+                                                  Stats& frame_stats) const {
+    const PhotonMappingSettings& s = settings_;
+    Stopwatch claim_watch;
+    const StereoClaims claims(kept.hits, left, right, scene_.tracer());
+    frame_stats.add("claim_ms", claim_watch.elapsed_ms());
+
+    Stopwatch right_watch;
+    const int width = right.width();
+    const PhotonGatherer gatherer(*map_, scene_.materials(), s.gather, s.radius, size_t(s.k));
+    const PrimaryShadingContext shading{scene_.tracer(), scene_.frame(), scene_.materials(), scene_.lights(),
+                                        s.light_samples};
+    const float* left_direct = left_film.layer("direct").data.data();
+    const float* left_indirect = left_film.layer("indirect").data.data();
+    float* direct = film.layer("direct").data.data();
+    float* indirect = film.layer("indirect").data.data();
+    float* reused_layer = film.add_layer("reused", 1).data.data();
+    const Vec3 eye = right.position();
+    std::mutex merge;
+    std::atomic<uint64_t> nonfinite{0}, reused{0}, reshaded_glossy{0}, strict_rejected{0}, shaded{0};
+
+    auto load = [](const float* layer, size_t pixel) {
+        return Vec3(layer[3 * pixel], layer[3 * pixel + 1], layer[3 * pixel + 2]);
+    };
+
+    parallel_for_tiles(width, right.height(), s.tile_size, [&](const Tile& tile) {
+        GatherScratch scratch;
+        PhotonQueryStats qs;
+        std::vector<LightSampleRecord> samples(size_t(std::max(s.light_samples, 0)));
+        uint64_t n_reused = 0, n_glossy = 0, n_rejected = 0, n_shaded = 0;
+        for (int y = tile.y0; y < tile.y1; ++y)
+            for (int x = tile.x0; x < tile.x1; ++x) {
+                const uint32_t pixel = uint32_t(size_t(y) * size_t(width) + size_t(x));
+                const uint32_t source = claims.source(pixel);
+                Vec3 Ld(0.0f), Li(0.0f);
+                bool from_left = source != StereoClaims::kNone;
+                std::optional<SurfaceInteraction> own;  // the right pixel's own hit, if traced
+                Ray ray;
+                if (!from_left || s.stereo.match == StereoMatch::Strict) {
+                    ray = right.generate_ray(float(x) + 0.5f, float(y) + 0.5f);
+                    Hit hit = scene_.tracer().intersect(ray);
+                    if (hit.valid()) own = make_interaction(scene_.frame(), ray, hit);
+                    if (from_left) {
+                        PrimaryHit mine;
+                        if (own) mine = primary_hit_of(*own, scene_.materials()[own->material]);
+                        from_left = same_surface_point(kept.hits[source], mine, right, s.stereo.tolerance);
+                        n_rejected += !from_left;
+                    }
+                }
+                if (from_left) {
+                    const PrimaryHit& h = kept.hits[source];
+                    const Material& m = scene_.materials()[h.point.material];
+                    if (s.stereo.reshade) {
+                        // View-independent parts from the left eye; the glossy lobe for this eye.
+                        const Vec3 wo = glm::normalize(eye - h.point.position);
+                        Ld = direct_radiance(m, h, wo, kept.samples_of(source));
+                        if (m.has_glossy_lobe()) {
+                            GatherPoint p = h.point;
+                            p.wo = wo;
+                            Li = gatherer.estimate(p, scratch, qs);
+                            ++n_glossy;
+                        } else {
+                            Li = load(left_indirect, source);
+                        }
+                    } else {
+                        Ld = load(left_direct, source);
+                        Li = load(left_indirect, source);
+                    }
+                    ++n_reused;
+                    reused_layer[pixel] = 1.0f;
+                } else if (own) {
+                    // Nobody claimed it (or strict mode refused): shade it as an independent eye.
+                    const Material& m = scene_.materials()[own->material];
+                    PrimaryHit ph = primary_hit_of(*own, m);
+                    Rng rng = [&] {
+                        if (auto q = left.pixel_of(own->position))
+                            return Rng::for_sample(s.seed, uint64_t(q->y) * uint64_t(left.width()) + uint64_t(q->x), 0, 0);
+                        return Rng::for_sample(s.seed, pixel, 0, 1);
+                    }();
+                    sample_direct_light(shading, *own, rng, samples, ph);
+                    Ld = direct_radiance(m, ph, own->wo, samples);
+                    Li = gatherer.estimate(ph.point, scratch, qs);
+                    ++n_shaded;
+                }
+                write_pixel(direct, pixel, finite_or_zero(Ld, nonfinite));
+                write_pixel(indirect, pixel, finite_or_zero(Li, nonfinite));
+            }
+        reused += n_reused, reshaded_glossy += n_glossy, strict_rejected += n_rejected, shaded += n_shaded;
+        std::lock_guard<std::mutex> lock(merge);
+        query_stats.merge(qs);
+    });
+    float* color = film.layer("color").data.data();
+    for (size_t i = 0; i < 3 * film.pixel_count(); ++i) color[i] = direct[i] + indirect[i];
+    frame_stats.add("right_pass_ms", right_watch.elapsed_ms());
+    const StereoClaimStats& c = claims.stats();
+    frame_stats.set("reuse_left_hits", double(c.left_hits));
+    frame_stats.set("reuse_back_side", double(c.back_side));
+    frame_stats.set("reuse_outside", double(c.outside));
+    frame_stats.set("reuse_occluded", double(c.occluded));
+    frame_stats.set("reuse_candidates", double(c.candidates));
+    frame_stats.set("reuse_claimed_pixels", double(c.claimed_pixels));
+    frame_stats.set("reuse_depth_conflicts", double(c.depth_conflicts));
+    frame_stats.set("reuse_strict_rejected", double(strict_rejected.load()));
+    frame_stats.set("reused_pixels", double(reused.load()));
+    // Of the right pixels that show geometry (reused or shaded), the share reused.
+    const double covered = double(reused.load() + shaded.load());
+    frame_stats.set("reuse_fraction", covered > 0 ? double(reused.load()) / covered : 0.0);
+    frame_stats.set("reuse_reshaded_glossy", double(reshaded_glossy.load()));
+    frame_stats.set("right_shaded_pixels", double(shaded.load()));
+    frame_stats.add("nonfinite_pixels", double(nonfinite.load()));
+}
+
+}  // namespace gilab

@@ -1,0 +1,266 @@
+// One eye of the photon technique: primary rays, next-event estimation and the photon
+// gather, fused per tile, split into a trace and a cell-sorted gather pass, tile-shared,
+// or foveated.
+#include <algorithm>
+#include <mutex>
+#include <optional>
+#include <tbb/parallel_sort.h>
+#include "core/interaction.hpp"
+#include "core/parallel.hpp"
+#include "core/rng.hpp"
+#include "techniques/photon_mapping/photon_passes.hpp"
+
+namespace gilab {
+
+namespace {
+
+// A primary hit waiting for its gather.
+struct HitRecord {
+    GatherPoint point;
+    uint32_t pixel = 0;
+    bool valid = false;
+};
+
+struct SortItem {
+    uint64_t key;   // PhotonGatherer::sort_key
+    uint32_t slot;  // index into the hit buffer
+    bool operator<(const SortItem& o) const { return key != o.key ? key < o.key : slot < o.slot; }
+    bool same_group(const SortItem& o) const { return key == o.key && key < PhotonGatherer::kUngrouped; }
+};
+
+}  // namespace
+
+void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOptions& options, Film& film,
+                                         PhotonQueryStats& query_stats, Stats& frame_stats) const {
+    const int width = camera.width(), height = camera.height();
+    const PhotonMappingSettings& s = settings_;
+    const PhotonGatherer gatherer(*map_, scene_.materials(), s.gather, s.radius, size_t(s.k));
+    std::optional<PhotonGatherer> periphery;
+    if (periphery_map_) periphery.emplace(*periphery_map_, scene_.materials(), s.gather, s.radius, size_t(s.k));
+    const PrimaryShadingContext shading{scene_.tracer(), scene_.frame(), scene_.materials(), scene_.lights(),
+                                        s.light_samples};
+    float* direct = film.layer("direct").data.data();
+    float* indirect = film.layer("indirect").data.data();
+    std::mutex merge;
+    std::atomic<uint64_t> nonfinite{0}, groups{0}, grouped_hits{0}, fetched{0};
+    KeptHits* keep = options.keep;
+    if (keep) {
+        // Kept from frame to frame: every pixel overwrites its entry, so no clearing.
+        keep->per_pixel = size_t(std::max(s.light_samples, 0));
+        keep->hits.resize(film.pixel_count());
+        keep->samples.resize(film.pixel_count() * keep->per_pixel);
+    }
+
+    // The light-sample stream of a hit: its own pixel's, or in a stereo right eye the
+    // stream of the left pixel that sees the same point (stereo-consistent noise).
+    auto stream_of = [&](const Vec3& x, uint32_t pixel) {
+        if (options.stream_eye)
+            if (auto q = options.stream_eye->pixel_of(x))
+                return Rng::for_sample(s.seed, uint64_t(q->y) * uint64_t(options.stream_eye->width()) + uint64_t(q->x), 0, 0);
+        return Rng::for_sample(s.seed, pixel, 0, options.view);
+    };
+    // Primary ray through (px, py), emission and next-event estimation for `pixel`; the
+    // hit is returned for the gather and its direct radiance written.
+    auto trace_pixel = [&](float px, float py, uint32_t pixel) {
+        thread_local std::vector<LightSampleRecord> scratch_samples;
+        HitRecord rec;
+        rec.pixel = pixel;
+        Vec3 L(0.0f);
+        Ray ray = camera.generate_ray(px, py);
+        Hit hit = scene_.tracer().intersect(ray);
+        if (hit.valid()) {
+            SurfaceInteraction si = make_interaction(scene_.frame(), ray, hit);
+            const Material& m = scene_.materials()[si.material];
+            PrimaryHit ph = primary_hit_of(si, m);
+            std::span<LightSampleRecord> samples;
+            if (keep) {
+                samples = {keep->samples.data() + size_t(pixel) * keep->per_pixel, keep->per_pixel};
+            } else {
+                scratch_samples.resize(size_t(std::max(s.light_samples, 0)));
+                samples = scratch_samples;
+            }
+            Rng rng = stream_of(si.position, pixel);
+            sample_direct_light(shading, si, rng, samples, ph);
+            L = direct_radiance(m, ph, si.wo, samples);
+            rec.point = ph.point;
+            rec.valid = true;
+            if (keep) keep->hits[pixel] = ph;
+        } else if (keep) {
+            keep->hits[pixel].valid = false;
+        }
+        write_pixel(direct, pixel, finite_or_zero(L, nonfinite));
+        return rec;
+    };
+    auto pixel_index = [&](int x, int y) { return uint32_t(size_t(y) * size_t(width) + size_t(x)); };
+    auto write_indirect = [&](uint32_t pixel, Vec3 v) { write_pixel(indirect, pixel, finite_or_zero(v, nonfinite)); };
+    // Gathers hits[items[b..e).slot]: runs of hits sharing a cell together (Algorithm 1)
+    // when `shared`, else one by one.
+    auto gather_sorted = [&](const std::vector<HitRecord>& hits, const std::vector<SortItem>& items, size_t b, size_t e,
+                             GatherScratch& scratch, PhotonQueryStats& qs, bool shared) {
+        std::vector<const GatherPoint*> points;
+        std::vector<Vec3> out;
+        uint64_t local_groups = 0, local_grouped = 0;
+        for (size_t i = b; i < e;) {
+            size_t j = i + 1;
+            if (shared)
+                while (j < e && items[j].same_group(items[i])) ++j;
+            if (j - i >= 2) {
+                points.clear();
+                for (size_t t = i; t < j; ++t) points.push_back(&hits[items[t].slot].point);
+                out.resize(points.size());
+                gatherer.estimate_group(gatherer.cell_of(points[0]->position), points, out, scratch, qs);
+                for (size_t t = i; t < j; ++t) write_indirect(hits[items[t].slot].pixel, out[t - i]);
+                ++local_groups;
+                local_grouped += j - i;
+            } else {
+                const HitRecord& h = hits[items[i].slot];
+                write_indirect(h.pixel, gatherer.estimate(h.point, scratch, qs));
+            }
+            i = j;
+        }
+        groups += local_groups;
+        grouped_hits += local_grouped;
+    };
+    // Hits in cell order (then by slot: a total order, so the parallel sort is
+    // deterministic).
+    auto sort_items = [&](const std::vector<HitRecord>& hits, const std::vector<uint32_t>& slots) {
+        std::vector<SortItem> items(slots.size());
+        auto fill = [&](size_t b, size_t e) {
+            for (size_t i = b; i < e; ++i) {
+                items[i] = {gatherer.sort_key(hits[slots[i]].point.position, slots[i]), slots[i]};
+            }
+        };
+        if (items.size() < 4096) {
+            fill(0, items.size());
+            std::sort(items.begin(), items.end());
+        } else {
+            parallel_for(items.size(), 2048, fill);
+            tbb::parallel_sort(items.begin(), items.end());
+        }
+        return items;
+    };
+    // Foveated tile (foveation.hpp): every pixel traces its primary and shadow rays; in
+    // 2×2 and 4×4 gather blocks the first hit gathers (over the periphery map) and the
+    // block's other hits on the same surface nearby take its indirect light.
+    const float share_distance2 = s.radius * s.radius;
+    auto shares_gather = [&](const HitRecord& a, const HitRecord& b) {
+        return a.point.material == b.point.material && glm::dot(a.point.normal, b.point.normal) > 0.95f &&
+               glm::dot(a.point.position - b.point.position, a.point.position - b.point.position) < share_distance2;
+    };
+    auto shade_foveated_tile = [&](const Tile& tile, GatherScratch& scratch, PhotonQueryStats& qs) {
+        for (int by = tile.y0; by < tile.y1; by += 4)
+            for (int bx = tile.x0; bx < tile.x1; bx += 4) {
+                const int bx1 = std::min(bx + 4, tile.x1), by1 = std::min(by + 4, tile.y1);
+                const int b = foveated_block_size(camera, s.foveation, bx, by);
+                const PhotonGatherer& g = b == 1 ? gatherer : *periphery;
+                for (int sy = by; sy < by1; sy += b)
+                    for (int sx = bx; sx < bx1; sx += b) {
+                        std::optional<HitRecord> gathered;
+                        Vec3 gathered_light(0.0f);
+                        for (int y = sy; y < std::min(sy + b, by1); ++y)
+                            for (int x = sx; x < std::min(sx + b, bx1); ++x) {
+                                HitRecord rec = trace_pixel(float(x) + 0.5f, float(y) + 0.5f, pixel_index(x, y));
+                                if (!rec.valid) {
+                                    write_indirect(rec.pixel, Vec3(0.0f));
+                                } else if (gathered && shares_gather(*gathered, rec)) {
+                                    write_indirect(rec.pixel, gathered_light);
+                                } else {
+                                    const Vec3 v = g.estimate(rec.point, scratch, qs);
+                                    write_indirect(rec.pixel, v);
+                                    if (!gathered) gathered = rec, gathered_light = v;
+                                }
+                            }
+                    }
+            }
+    };
+
+    if (!s.split) {
+        Stopwatch watch;
+        parallel_for_tiles(width, height, s.tile_size, [&](const Tile& tile) {
+            GatherScratch scratch;
+            PhotonQueryStats qs;
+            if (s.foveation.enabled) {
+                shade_foveated_tile(tile, scratch, qs);
+            } else if (!s.tile_shared) {
+                for (int y = tile.y0; y < tile.y1; ++y)
+                    for (int x = tile.x0; x < tile.x1; ++x) {
+                        HitRecord rec = trace_pixel(float(x) + 0.5f, float(y) + 0.5f, pixel_index(x, y));
+                        write_indirect(rec.pixel, rec.valid ? gatherer.estimate(rec.point, scratch, qs) : Vec3(0.0f));
+                    }
+            } else {
+                // Trace the tile, then group its hits by cell.
+                std::vector<HitRecord> tile_hits;
+                std::vector<uint32_t> valid;
+                for (int y = tile.y0; y < tile.y1; ++y)
+                    for (int x = tile.x0; x < tile.x1; ++x) {
+                        HitRecord rec = trace_pixel(float(x) + 0.5f, float(y) + 0.5f, pixel_index(x, y));
+                        if (rec.valid)
+                            valid.push_back(uint32_t(tile_hits.size()));
+                        else
+                            write_indirect(rec.pixel, Vec3(0.0f));
+                        tile_hits.push_back(rec);
+                    }
+                std::vector<SortItem> items = sort_items(tile_hits, valid);
+                gather_sorted(tile_hits, items, 0, items.size(), scratch, qs, true);
+            }
+            fetched += scratch.fetched;
+            std::lock_guard<std::mutex> lock(merge);
+            query_stats.merge(qs);
+        });
+        frame_stats.add("fused_ms", watch.elapsed_ms());
+    } else {
+        // Pass 1: every primary hit into a buffer (position, normal, direction, material).
+        Stopwatch trace_watch;
+        std::vector<HitRecord> hits(size_t(width) * size_t(height));
+        parallel_for_tiles(width, height, s.tile_size, [&](const Tile& tile) {
+            for (int y = tile.y0; y < tile.y1; ++y)
+                for (int x = tile.x0; x < tile.x1; ++x) {
+                    HitRecord rec = trace_pixel(float(x) + 0.5f, float(y) + 0.5f, pixel_index(x, y));
+                    hits[rec.pixel] = rec;
+                }
+        });
+        frame_stats.add("trace_pass_ms", trace_watch.elapsed_ms());
+        // Pass 2: gather in cell order for memory coherence, results written by pixel.
+        Stopwatch sort_watch;
+        std::vector<uint32_t> valid;
+        valid.reserve(hits.size());
+        for (const HitRecord& h : hits) {
+            if (h.valid)
+                valid.push_back(h.pixel);
+            else
+                write_indirect(h.pixel, Vec3(0.0f));
+        }
+        std::vector<SortItem> items = sort_items(hits, valid);
+        frame_stats.add("sort_ms", sort_watch.elapsed_ms());
+        Stopwatch gather_watch;
+        // Chunks end on cell boundaries so a tile-shared group is never split.
+        std::vector<size_t> bounds{0};
+        const size_t chunk = 1024;
+        for (size_t i = chunk; i < items.size(); i += chunk) {
+            if (s.tile_shared)
+                while (i < items.size() && items[i].same_group(items[i - 1])) ++i;
+            if (i >= items.size()) break;
+            bounds.push_back(i);
+        }
+        bounds.push_back(items.size());
+        parallel_for(bounds.size() - 1, 1, [&](size_t cb, size_t ce) {
+            GatherScratch scratch;
+            PhotonQueryStats qs;
+            for (size_t c = cb; c < ce; ++c)
+                gather_sorted(hits, items, bounds[c], bounds[c + 1], scratch, qs, s.tile_shared);
+            fetched += scratch.fetched;
+            std::lock_guard<std::mutex> lock(merge);
+            query_stats.merge(qs);
+        });
+        frame_stats.add("gather_pass_ms", gather_watch.elapsed_ms());
+    }
+
+    float* color = film.layer("color").data.data();
+    for (size_t i = 0; i < 3 * film.pixel_count(); ++i) color[i] = direct[i] + indirect[i];
+    frame_stats.add("nonfinite_pixels", double(nonfinite.load()));
+    frame_stats.add("tile_groups", double(groups.load()));
+    frame_stats.add("tile_grouped_hits", double(grouped_hits.load()));
+    frame_stats.add("tile_fetched_photons", double(fetched.load()));
+}
+
+}  // namespace gilab
