@@ -4,8 +4,9 @@
 // right eye equals the independently rendered one within float rounding for Lambertian
 // surfaces and, with the glossy lobe re-evaluated, for glossy ones — while copying the
 // left colour is measurably wrong there; occluded and back-side hits never claim a pixel
-// and the nearest candidate wins a pixel; stereo renders do not depend on the thread
-// count; foveation leaves the fovea untouched.
+// and the nearest candidate wins a pixel; strict mode and crack filling trade reuse for
+// error as intended; stereo renders do not depend on the thread count; foveation leaves
+// the fovea untouched, follows the gaze and gathers less in the periphery.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -323,6 +324,47 @@ TEST(StereoReuse, StrictModeReusesOnlyMatchingPointsAndErrsLess) {
     EXPECT_LT(strict_error, nearest_error);
 }
 
+TEST(StereoReuse, CrackFillingReusesMoreWithSmallError) {
+    Scene scene = make_cornell_box();
+    HmdRig rig(find_hmd_preset("vive"), scene.hmd->pose);
+    rig.set_resolution(216, 240);
+    const ViewSet views = ViewSet::stereo_pair(rig.eye(Eye::Left), rig.eye(Eye::Right));
+    // Many light samples: a filled pixel draws the neighbour's light samples, not those
+    // of its own point, so with one sample the comparison would measure noise.
+    const nlohmann::json base = with(kBase, {{"light_samples", 16}});
+    Stats nearest_stats, fill_stats;
+    std::vector<Film> separate = render_views(scene, views, base);
+    std::vector<Film> nearest = render_views(scene, views, with(base, {{"stereo_reuse", true}}), &nearest_stats);
+    std::vector<Film> filled =
+        render_views(scene, views, with(base, {{"stereo_reuse", true}, {"stereo_fill", true}}), &fill_stats);
+    EXPECT_EQ(nearest_stats.get("reuse_crack_filled"), 0);
+    EXPECT_GT(fill_stats.get("reuse_crack_filled"), 100);
+    EXPECT_GT(fill_stats.get("reuse_fraction"), nearest_stats.get("reuse_fraction"));
+    // Filled pixels (reused only with filling) differ from the independent render about as
+    // much as the nearest-pixel claims do (both reuse a point up to a pixel or so away).
+    auto mean_relative_difference = [&](const Film& image, auto&& selected) {
+        double diff = 0, total = 0;
+        size_t count = 0;
+        for (int y = 0; y < image.height(); ++y)
+            for (int x = 0; x < image.width(); ++x) {
+                if (!selected(size_t(y) * size_t(image.width()) + size_t(x))) continue;
+                ++count;
+                diff += std::abs(luminance(image.get("color", x, y)) - luminance(separate[1].get("color", x, y)));
+                total += luminance(separate[1].get("color", x, y));
+            }
+        return std::pair{count, diff / total};
+    };
+    const auto& fill_mask = filled[1].layer("reused").data;
+    const auto& nearest_mask = nearest[1].layer("reused").data;
+    auto [fill_count, fill_error] =
+        mean_relative_difference(filled[1], [&](size_t i) { return fill_mask[i] == 1.0f && nearest_mask[i] != 1.0f; });
+    auto [nearest_count, nearest_error] =
+        mean_relative_difference(nearest[1], [&](size_t i) { return nearest_mask[i] == 1.0f; });
+    EXPECT_EQ(double(fill_count), fill_stats.get("reuse_crack_filled"));
+    EXPECT_GT(nearest_count, fill_count);
+    EXPECT_LT(fill_error, 2.0 * nearest_error);
+}
+
 TEST(StereoReuse, IdenticalAtAnyThreadCount) {
     Scene scene = make_cornell_box();
     HmdRig rig(find_hmd_preset("quest2"), scene.hmd->pose);
@@ -330,6 +372,7 @@ TEST(StereoReuse, IdenticalAtAnyThreadCount) {
     const ViewSet views = ViewSet::stereo_pair(rig.eye(Eye::Left), rig.eye(Eye::Right));
     for (nlohmann::json s : {with(kBase, {{"stereo_reuse", true}}),
                              with(kBase, {{"stereo_reuse", true}, {"stereo_match", "strict"}, {"light_samples", 2}}),
+                             with(kBase, {{"stereo_reuse", true}, {"stereo_fill", true}}),
                              with(kBase, {{"foveated", true}, {"fovea_angle", 15}})}) {
         std::vector<Film> one, two;
         {
@@ -430,6 +473,8 @@ TEST(StereoReuse, BadSettingsAreErrorsNamingTheKey) {
     };
     EXPECT_NE(error(with(kBase, {{"stereo_match", "closest"}})).find("stereo_match"), std::string::npos);
     EXPECT_NE(error(with(kBase, {{"stereo_tolerance", -1}})).find("stereo_tolerance"), std::string::npos);
+    EXPECT_NE(error(with(kBase, {{"stereo_fill", true}, {"stereo_match", "strict"}})).find("stereo_fill"),
+              std::string::npos);
     EXPECT_NE(error(with(kBase, {{"foveated", true}, {"fovea_angle", 0}})).find("fovea_angle"), std::string::npos);
     EXPECT_NE(error(with(kBase, {{"foveated", true}, {"periphery_photon_stride", 0}})).find("periphery_photon_stride"),
               std::string::npos);

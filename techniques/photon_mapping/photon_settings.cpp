@@ -35,6 +35,7 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     std::string match = s.get<std::string>("stereo_match", to_string(p.stereo.match));
     p.stereo.tolerance = s.get<float>("stereo_tolerance", p.stereo.tolerance);
     p.stereo.reshade = s.get<bool>("stereo_reshade", p.stereo.reshade);
+    p.stereo.fill = s.get<bool>("stereo_fill", p.stereo.fill);
     p.foveation.enabled = s.get<bool>("foveated", p.foveation.enabled);
     p.foveation.fovea_degrees = s.get<float>("fovea_angle", p.foveation.fovea_degrees);
     p.foveation.periphery_photon_stride = s.get<int>("periphery_photon_stride", p.foveation.periphery_photon_stride);
@@ -97,6 +98,9 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
                                    std::to_string(p.tile_size));
         if (p.stereo.enabled)
             throw Error(where, "settings 'foveated' and 'stereo_reuse' cannot be combined yet");
+    }
+    if (p.stereo.fill && p.stereo.match != StereoMatch::Nearest) {
+        throw Error(where, "setting 'stereo_fill' needs stereo_match=nearest (strict mode reuses only exact matches)");
     }
     return p;
 }

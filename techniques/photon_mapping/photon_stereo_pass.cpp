@@ -30,7 +30,7 @@ void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const E
     float* reused_layer = film.add_layer("reused", 1).data.data();
     const Vec3 eye = right.position();
     std::mutex merge;
-    std::atomic<uint64_t> nonfinite{0}, reused{0}, reshaded_glossy{0}, strict_rejected{0}, shaded{0};
+    std::atomic<uint64_t> nonfinite{0}, reused{0}, reshaded_glossy{0}, strict_rejected{0}, shaded{0}, filled{0};
 
     auto load = [](const float* layer, size_t pixel) {
         return Vec3(layer[3 * pixel], layer[3 * pixel + 1], layer[3 * pixel + 2]);
@@ -40,24 +40,27 @@ void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const E
         GatherScratch scratch;
         PhotonQueryStats qs;
         std::vector<LightSampleRecord> samples(size_t(std::max(s.light_samples, 0)));
-        uint64_t n_reused = 0, n_glossy = 0, n_rejected = 0, n_shaded = 0;
+        uint64_t n_reused = 0, n_glossy = 0, n_rejected = 0, n_shaded = 0, n_filled = 0;
         for (int y = tile.y0; y < tile.y1; ++y)
             for (int x = tile.x0; x < tile.x1; ++x) {
                 const uint32_t pixel = uint32_t(size_t(y) * size_t(width) + size_t(x));
-                const uint32_t source = claims.source(pixel);
                 Vec3 Ld(0.0f), Li(0.0f);
+                uint32_t source = claims.source(pixel);
                 bool from_left = source != StereoClaims::kNone;
                 std::optional<SurfaceInteraction> own;  // the right pixel's own hit, if traced
-                Ray ray;
                 if (!from_left || s.stereo.match == StereoMatch::Strict) {
-                    ray = right.generate_ray(float(x) + 0.5f, float(y) + 0.5f);
+                    Ray ray = right.generate_ray(float(x) + 0.5f, float(y) + 0.5f);
                     Hit hit = scene_.tracer().intersect(ray);
                     if (hit.valid()) own = make_interaction(scene_.frame(), ray, hit);
+                    PrimaryHit mine;
+                    if (own) mine = primary_hit_of(*own, scene_.materials()[own->material]);
                     if (from_left) {
-                        PrimaryHit mine;
-                        if (own) mine = primary_hit_of(*own, scene_.materials()[own->material]);
                         from_left = same_surface_point(kept.hits[source], mine, right, s.stereo.tolerance);
                         n_rejected += !from_left;
+                    } else if (own && s.stereo.fill && s.stereo.match == StereoMatch::Nearest) {
+                        source = crack_fill_source(claims, kept.hits, mine, right, x, y);
+                        from_left = source != StereoClaims::kNone;
+                        n_filled += from_left;
                     }
                 }
                 if (from_left) {
@@ -99,6 +102,7 @@ void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const E
                 write_pixel(indirect, pixel, finite_or_zero(Li, nonfinite));
             }
         reused += n_reused, reshaded_glossy += n_glossy, strict_rejected += n_rejected, shaded += n_shaded;
+        filled += n_filled;
         std::lock_guard<std::mutex> lock(merge);
         query_stats.merge(qs);
     });
@@ -115,6 +119,7 @@ void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const E
     frame_stats.set("reuse_depth_conflicts", double(c.depth_conflicts));
     frame_stats.set("reuse_strict_rejected", double(strict_rejected.load()));
     frame_stats.set("reused_pixels", double(reused.load()));
+    frame_stats.set("reuse_crack_filled", double(filled.load()));
     // Of the right pixels that show geometry (reused or shaded), the share reused.
     const double covered = double(reused.load() + shaded.load());
     frame_stats.set("reuse_fraction", covered > 0 ? double(reused.load()) / covered : 0.0);

@@ -131,7 +131,7 @@ void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& fil
                             "tile_grouped_hits", "tile_fetched_photons", "left_ms", "right_ms",
                             "claim_ms", "right_pass_ms", "reuse_left_hits", "reuse_back_side", "reuse_outside",
                             "reuse_occluded", "reuse_candidates", "reuse_claimed_pixels", "reuse_depth_conflicts",
-                            "reuse_strict_rejected", "reused_pixels", "reuse_fraction", "reuse_reshaded_glossy",
+                            "reuse_strict_rejected", "reused_pixels", "reuse_crack_filled", "reuse_fraction", "reuse_reshaded_glossy",
                             "right_shaded_pixels"})
         stats_.set(key, frame.get(key));
     stats_.set("render_ms", ms);

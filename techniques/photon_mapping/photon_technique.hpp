@@ -25,8 +25,9 @@
 // hits (stereo_reuse.hpp); stereo_match (nearest: the paper's claim | strict: only where
 // the right pixel's own ray hits the same point within stereo_tolerance (0.5) pixel
 // footprints), stereo_reshade (true: re-evaluate the glossy lobe for the right eye;
-// false: copy the left colour, the paper's behaviour). The right film gets a "reused"
-// layer (1 where the pixel came from the left eye).
+// false: copy the left colour, the paper's behaviour), stereo_fill (false: true fills
+// one-pixel reprojection cracks from neighbouring claims, nearest mode only). The right
+// film gets a "reused" layer (1 where the pixel came from the left eye).
 //
 // Foveation (foveation.hpp): foveated (false), fovea_angle (10 degrees),
 // periphery_photon_stride (4), gaze_yaw / gaze_pitch (0 degrees: the eye's forward axis). Needs pass=fused, tile_shared=false, a tile_size that is a

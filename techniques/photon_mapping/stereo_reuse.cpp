@@ -141,4 +141,22 @@ bool same_surface_point(const PrimaryHit& left_hit, const PrimaryHit& right_hit,
     return glm::length(left_hit.point.position - right_hit.point.position) <= tolerance * footprint;
 }
 
+uint32_t crack_fill_source(const StereoClaims& claims, const std::vector<PrimaryHit>& left_hits,
+                           const PrimaryHit& own_hit, const EyeCamera& right, int x, int y) {
+    uint32_t best = StereoClaims::kNone;
+    float best_distance = kInfinity;
+    for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+            const int nx = x + dx, ny = y + dy;
+            if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= right.width() || ny >= right.height()) continue;
+            const uint32_t source = claims.source(size_t(ny) * size_t(right.width()) + size_t(nx));
+            if (source == StereoClaims::kNone) continue;
+            const PrimaryHit& candidate = left_hits[source];
+            if (!same_surface_point(candidate, own_hit, right, kCrackFillTolerance)) continue;
+            const float d = glm::length(candidate.point.position - own_hit.point.position);
+            if (d < best_distance) best = source, best_distance = d;
+        }
+    return best;
+}
+
 }  // namespace gilab

@@ -18,6 +18,11 @@
 //   centre. Nearest mode (the paper's) accepts that; strict mode traces the right pixel's
 //   own primary ray and reuses only when the claiming hit lies on the same triangle
 //   group (same material, normals within ~8°) within `tolerance` pixel footprints of it.
+// * Forward reprojection leaves one-pixel cracks where the right eye sees a surface less
+//   obliquely than the left (its image of the surface is magnified). With `fill`, an
+//   unclaimed pixel whose own hit lies within 1.5 pixel footprints of a neighbour's
+//   claiming hit on the same surface reuses that hit (nearest mode only): the error is
+//   of the same kind as a nearest-pixel claim's, and the pixel skips its gather.
 #include <atomic>
 #include <cstdint>
 #include <optional>
@@ -35,7 +40,11 @@ struct StereoReuseSettings {
     StereoMatch match = StereoMatch::Nearest;
     float tolerance = 0.5f;   // strict mode: allowed distance in right-eye pixel footprints
     bool reshade = true;      // re-evaluate the glossy lobe for the right eye's direction
+    bool fill = false;        // fill cracks from neighbouring claims (nearest mode)
 };
+
+// Footprints within which a crack takes a neighbour's claiming hit.
+inline constexpr float kCrackFillTolerance = 1.5f;
 
 const char* to_string(StereoMatch match);
 
@@ -83,5 +92,11 @@ private:
 // claiming left hit, within `tolerance` pixel footprints?
 bool same_surface_point(const PrimaryHit& left_hit, const PrimaryHit& right_hit, const EyeCamera& right,
                         float tolerance);
+
+// Crack filling: of the left hits claiming the 8 neighbours of right pixel (x, y), the one
+// nearest to the pixel's own hit among those on the same surface within
+// kCrackFillTolerance footprints (same_surface_point), or kNone.
+uint32_t crack_fill_source(const StereoClaims& claims, const std::vector<PrimaryHit>& left_hits,
+                           const PrimaryHit& own_hit, const EyeCamera& right, int x, int y);
 
 }  // namespace gilab
