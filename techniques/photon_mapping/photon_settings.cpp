@@ -96,8 +96,6 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
         if (p.tile_size % 4 != 0)
             throw Error(where, "setting 'foveated' needs a tile_size that is a multiple of 4 (4×4 shading blocks), got " +
                                    std::to_string(p.tile_size));
-        if (p.stereo.enabled)
-            throw Error(where, "settings 'foveated' and 'stereo_reuse' cannot be combined yet");
     }
     if (p.stereo.fill && p.stereo.match != StereoMatch::Nearest) {
         throw Error(where, "setting 'stereo_fill' needs stereo_match=nearest (strict mode reuses only exact matches)");

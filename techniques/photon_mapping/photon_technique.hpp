@@ -30,8 +30,9 @@
 // film gets a "reused" layer (1 where the pixel came from the left eye).
 //
 // Foveation (foveation.hpp): foveated (false), fovea_angle (10 degrees),
-// periphery_photon_stride (4), gaze_yaw / gaze_pitch (0 degrees: the eye's forward axis). Needs pass=fused, tile_shared=false, a tile_size that is a
-// multiple of 4, and no stereo_reuse.
+// periphery_photon_stride (4), gaze_yaw / gaze_pitch (0 degrees: the eye's forward axis).
+// Needs pass=fused, tile_shared=false and a tile_size that is a multiple of 4. With
+// stereo_reuse the right eye's unclaimed pixels are gathered at the full rate.
 #include <cstdint>
 #include <memory>
 #include <optional>
