@@ -2,9 +2,9 @@
 
 #include <atomic>
 #include <cmath>
-#include <sstream>
 #include "core/bsdf.hpp"
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "core/interaction.hpp"
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
@@ -29,13 +29,6 @@ struct PathSample {
 // Adds a contribution that reached the eye after `bounces` scattering events.
 void add_light(PathSample& s, int bounces, const Vec3& value) {
     (bounces <= 1 ? s.direct : s.indirect) += value;
-}
-
-std::string format_number(double v) {
-    std::ostringstream out;
-    out.precision(9);
-    out << v;
-    return out.str();
 }
 
 }  // namespace

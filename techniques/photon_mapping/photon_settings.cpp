@@ -1,20 +1,9 @@
 #include <cmath>
-#include <sstream>
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "techniques/photon_mapping/photon_technique.hpp"
 
 namespace gilab {
-
-namespace {
-
-std::string number(double v) {
-    std::ostringstream out;
-    out.precision(9);
-    out << v;
-    return out.str();
-}
-
-}  // namespace
 
 PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     PhotonMappingSettings p;
@@ -45,7 +34,7 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     if (photons < 1) throw Error(where, "setting 'photons' must be at least 1, got " + std::to_string(photons));
     p.photons = uint64_t(photons);
     if (!(p.radius > 0.0f) || !std::isfinite(p.radius))
-        throw Error(where, "setting 'radius' must be positive and finite, got " + number(p.radius));
+        throw Error(where, "setting 'radius' must be positive and finite, got " + format_number(p.radius));
     if (gather == "radius")
         p.gather = GatherMode::Radius;
     else if (gather == "knn")
@@ -77,17 +66,17 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     else
         throw Error(where, "setting 'stereo_match' must be 'nearest' or 'strict', got '" + match + "'");
     if (!(p.stereo.tolerance >= 0.0f) || !std::isfinite(p.stereo.tolerance))
-        throw Error(where, "setting 'stereo_tolerance' must be a finite number of pixels ≥ 0, got " + number(p.stereo.tolerance));
+        throw Error(where, "setting 'stereo_tolerance' must be a finite number of pixels ≥ 0, got " + format_number(p.stereo.tolerance));
     if (p.light_samples > 0xffff)
         throw Error(where, "setting 'light_samples' must be at most 65535, got " + std::to_string(p.light_samples));
     if (p.foveation.enabled) {
         const float angle = p.foveation.fovea_degrees;
         if (!(angle > 0.0f && angle < 180.0f))
-            throw Error(where, "setting 'fovea_angle' must be in (0, 180) degrees, got " + number(angle));
+            throw Error(where, "setting 'fovea_angle' must be in (0, 180) degrees, got " + format_number(angle));
         for (auto [key, value] : {std::pair{"gaze_yaw", p.foveation.gaze_yaw_degrees},
                                   std::pair{"gaze_pitch", p.foveation.gaze_pitch_degrees}})
             if (!(std::abs(value) <= 90.0f))
-                throw Error(where, std::string("setting '") + key + "' must be within ±90 degrees, got " + number(value));
+                throw Error(where, std::string("setting '") + key + "' must be within ±90 degrees, got " + format_number(value));
         if (p.foveation.periphery_photon_stride < 1)
             throw Error(where, "setting 'periphery_photon_stride' must be at least 1, got " +
                                    std::to_string(p.foveation.periphery_photon_stride));

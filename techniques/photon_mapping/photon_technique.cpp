@@ -1,7 +1,7 @@
 #include "techniques/photon_mapping/photon_technique.hpp"
 
-#include <sstream>
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "techniques/photon_mapping/photon_passes.hpp"
 #include "techniques/photon_mapping/photon_tracer.hpp"
 
@@ -10,17 +10,6 @@
 #endif
 
 namespace gilab {
-
-namespace {
-
-std::string number(double v) {
-    std::ostringstream out;
-    out.precision(9);
-    out << v;
-    return out.str();
-}
-
-}  // namespace
 
 PhotonMappingTechnique::PhotonMappingTechnique() = default;
 PhotonMappingTechnique::~PhotonMappingTechnique() = default;
@@ -115,7 +104,7 @@ void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& fil
         film.metadata["technique"] = "photon";
         film.metadata["view"] = v < views.names.size() ? views.names[v] : "mono";
         film.metadata["photons"] = std::to_string(settings_.photons);
-        film.metadata["radius"] = number(settings_.radius);
+        film.metadata["radius"] = format_number(settings_.radius);
         film.metadata["gather"] = settings_.gather == GatherMode::Knn ? "knn" : "radius";
         film.metadata["photon_map"] = to_string(settings_.photon_map);
         film.metadata["seed"] = std::to_string(settings_.seed);
@@ -125,7 +114,7 @@ void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& fil
         films[v] = std::move(film);
     }
     double ms = watch.elapsed_ms();
-    for (Film& film : films) film.metadata["render_time_seconds"] = number(ms / 1000.0);
+    for (Film& film : films) film.metadata["render_time_seconds"] = format_number(ms / 1000.0);
     // Per-frame figures replace the previous frame's.
     for (const char* key : {"fused_ms", "trace_pass_ms", "sort_ms", "gather_pass_ms", "nonfinite_pixels", "tile_groups",
                             "tile_grouped_hits", "tile_fetched_photons", "left_ms", "right_ms",

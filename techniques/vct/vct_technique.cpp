@@ -2,9 +2,9 @@
 
 #include <atomic>
 #include <cmath>
-#include <sstream>
 #include "core/bsdf.hpp"
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "core/interaction.hpp"
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
@@ -18,13 +18,6 @@
 namespace gilab {
 
 namespace {
-
-std::string format_number(double v) {
-    std::ostringstream out;
-    out.precision(9);
-    out << v;
-    return out.str();
-}
 
 // One face of a voxel's G-buffer as the lighting passes read it.
 struct FaceInput {
