@@ -4,6 +4,7 @@
 #include <atomic>
 #include <span>
 #include <vector>
+#include "core/rng.hpp"
 #include "techniques/photon_mapping/photon_technique.hpp"
 #include "techniques/photon_mapping/primary_hit.hpp"
 
@@ -25,6 +26,17 @@ struct PhotonMappingTechnique::ViewOptions {
     const EyeCamera* stream_eye = nullptr;   // stereo right eye: key by the left pixel seeing the point
     KeptHits* keep = nullptr;                // keep every hit (left eye of a reusing stereo render)
 };
+
+// The light-sample stream of a hit seen by `pixel` of view `view`: its own pixel's, or,
+// when `stream_eye` is given (a stereo right eye, with the left eye), the stream of the
+// left pixel that sees the same point, so both eyes draw the same samples there.
+inline Rng light_sample_stream(uint64_t seed, const EyeCamera* stream_eye, const Vec3& x, uint32_t pixel,
+                               uint64_t view) {
+    if (stream_eye)
+        if (auto q = stream_eye->pixel_of(x))
+            return Rng::for_sample(seed, uint64_t(q->y) * uint64_t(stream_eye->width()) + uint64_t(q->x), 0, 0);
+    return Rng::for_sample(seed, pixel, 0, view);
+}
 
 // A non-finite radiance is counted and written as black.
 inline Vec3 finite_or_zero(const Vec3& v, std::atomic<uint64_t>& nonfinite) {

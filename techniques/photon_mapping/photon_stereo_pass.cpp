@@ -88,11 +88,7 @@ void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const E
                     // Nobody claimed it (or strict mode refused): shade it as an independent eye.
                     const Material& m = scene_.materials()[own->material];
                     PrimaryHit ph = primary_hit_of(*own, m);
-                    Rng rng = [&] {
-                        if (auto q = left.pixel_of(own->position))
-                            return Rng::for_sample(s.seed, uint64_t(q->y) * uint64_t(left.width()) + uint64_t(q->x), 0, 0);
-                        return Rng::for_sample(s.seed, pixel, 0, 1);
-                    }();
+                    Rng rng = light_sample_stream(s.seed, &left, own->position, pixel, 1);
                     sample_direct_light(shading, *own, rng, samples, ph);
                     Ld = direct_radiance(m, ph, own->wo, samples);
                     Li = gatherer.estimate(ph.point, scratch, qs);

@@ -51,14 +51,6 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
         keep->samples.resize(film.pixel_count() * keep->per_pixel);
     }
 
-    // The light-sample stream of a hit: its own pixel's, or in a stereo right eye the
-    // stream of the left pixel that sees the same point (stereo-consistent noise).
-    auto stream_of = [&](const Vec3& x, uint32_t pixel) {
-        if (options.stream_eye)
-            if (auto q = options.stream_eye->pixel_of(x))
-                return Rng::for_sample(s.seed, uint64_t(q->y) * uint64_t(options.stream_eye->width()) + uint64_t(q->x), 0, 0);
-        return Rng::for_sample(s.seed, pixel, 0, options.view);
-    };
     // Primary ray through (px, py), emission and next-event estimation for `pixel`; the
     // hit is returned for the gather and its direct radiance written.
     auto trace_pixel = [&](float px, float py, uint32_t pixel) {
@@ -79,7 +71,7 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
                 scratch_samples.resize(size_t(std::max(s.light_samples, 0)));
                 samples = scratch_samples;
             }
-            Rng rng = stream_of(si.position, pixel);
+            Rng rng = light_sample_stream(s.seed, options.stream_eye, si.position, pixel, options.view);
             sample_direct_light(shading, si, rng, samples, ph);
             L = direct_radiance(m, ph, si.wo, samples);
             rec.point = ph.point;
