@@ -1,5 +1,7 @@
 #include "accel/esvo.hpp"
+
 #include "accel/child_mask.hpp"
+#include "accel/octree_path.hpp"
 #include "core/error.hpp"
 #include "core/morton.hpp"
 
@@ -146,28 +148,11 @@ bool Esvo::occupied(const Vec3& p) const {
 }
 
 std::vector<uint64_t> Esvo::decode() const {
-    std::vector<uint64_t> codes;
-    if (empty()) return codes;
+    if (empty()) return {};
     if (depth_ == 0) return {0};
-    struct Item {
-        uint32_t d;
-        int level;
-        uint64_t code;
-    };
-    std::vector<Item> stack{{root(), 0, 0}};
-    while (!stack.empty()) {
-        Item it = stack.back();
-        stack.pop_back();
-        if (it.d == kLeafChild) {
-            codes.push_back(it.code);
-            continue;
-        }
-        for (int s = 7; s >= 0; --s) {  // reversed so slot 0 pops first: Morton order
-            uint32_t c = child(it.d, s);
-            if (c != kInvalidNode) stack.push_back({c, it.level + 1, it.code << 3 | uint64_t(s)});
-        }
-    }
-    return codes;
+    return collect_leaf_codes(
+        root(), kInvalidNode, [&](uint32_t d, int slot) { return child(d, slot); },
+        [](uint32_t d, int) { return d == kLeafChild; });
 }
 
 Stats Esvo::stats() const {

@@ -43,4 +43,31 @@ std::optional<OctreePath> box_to_path(const VoxelGrid& grid, const Bounds3& box,
 // Path of the leaf voxel (level = grid depth) holding a world point; nullopt outside.
 std::optional<OctreePath> point_to_path(const VoxelGrid& grid, const Vec3& point);
 
+// Morton codes of every leaf below `root`, ascending: a depth-first descent that takes
+// child slots in Morton order. child(node, slot) returns a child or `none`;
+// is_leaf(node, level) ends a path. Shared by the pointer-based trees (ESVO, SVDAG).
+template <typename Child, typename IsLeaf>
+std::vector<uint64_t> collect_leaf_codes(uint32_t root, uint32_t none, Child&& child, IsLeaf&& is_leaf) {
+    struct Item {
+        uint32_t node;
+        int level;
+        uint64_t code;
+    };
+    std::vector<uint64_t> codes;
+    std::vector<Item> stack{{root, 0, 0}};
+    while (!stack.empty()) {
+        const Item it = stack.back();
+        stack.pop_back();
+        if (is_leaf(it.node, it.level)) {
+            codes.push_back(it.code);
+            continue;
+        }
+        for (int s = 7; s >= 0; --s) {  // reversed so slot 0 pops first: Morton order
+            const uint32_t c = child(it.node, s);
+            if (c != none) stack.push_back({c, it.level + 1, it.code << 3 | uint64_t(s)});
+        }
+    }
+    return codes;
+}
+
 }  // namespace gilab

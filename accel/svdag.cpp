@@ -403,27 +403,10 @@ bool Svdag::occupied(const Vec3& p) const {
 }
 
 std::vector<uint64_t> Svdag::decode() const {
-    std::vector<uint64_t> codes;
-    if (empty()) return codes;
-    struct Item {
-        uint32_t node;
-        int level;
-        uint64_t code;
-    };
-    std::vector<Item> stack{{root(), 0, 0}};
-    while (!stack.empty()) {
-        Item it = stack.back();
-        stack.pop_back();
-        if (it.level == depth_) {
-            codes.push_back(it.code);
-            continue;
-        }
-        for (int s = 7; s >= 0; --s) {  // reversed so slot 0 pops first: Morton order
-            uint32_t c = child(it.node, s);
-            if (c != kInvalidNode) stack.push_back({c, it.level + 1, it.code << 3 | uint64_t(s)});
-        }
-    }
-    return codes;
+    if (empty()) return {};
+    return collect_leaf_codes(
+        root(), kInvalidNode, [&](uint32_t node, int slot) { return child(node, slot); },
+        [&](uint32_t, int level) { return level == depth_; });
 }
 
 Stats Svdag::stats() const {
