@@ -14,6 +14,7 @@ packages=(
   libcgal-dev libgmp-dev libmpfr-dev libopenexr-dev libimath-dev libstb-dev
   libopenvdb-dev libboost-iostreams-dev liboctomap-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev libnanoflann-dev
+  gnuplot-nox
 )
 missing=()
 for p in "${packages[@]}"; do

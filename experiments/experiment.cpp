@@ -1,5 +1,6 @@
 #include "experiments/experiment.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <ctime>
 #include <iostream>
@@ -7,9 +8,22 @@
 #include "core/error.hpp"
 #include "core/image_io.hpp"
 #include "core/stats.hpp"
+#include "experiments/plot.hpp"
 #include "experiments/result_writers.hpp"
 
 namespace gilab {
+
+namespace {
+// Image alt text: brackets and backslashes would end or bend the markdown link.
+std::string markdown_alt_text(const std::string& text) {
+    std::string out;
+    for (char c : text) {
+        if (c == '[' || c == ']' || c == '\\') out += '\\';
+        out += (c == '\n' || c == '\r') ? ' ' : c;
+    }
+    return out;
+}
+}  // namespace
 
 void ExperimentContext::say(const std::string& message) const {
     if (log) *log << "  " << message << std::endl;
@@ -39,6 +53,24 @@ ExperimentOutput run_and_write(const Experiment& experiment, ExperimentContext c
     ExperimentOutput output = experiment.run(context);
     double seconds = watch.elapsed_ms() / 1000.0;
     if (output.tables.empty()) throw Error(experiment.name, "experiment produced no table");
+
+    // Figures are drawn before results.json is written, so the files and notes it lists
+    // are final. A figure that cannot be drawn must not cost the run its tables.
+    std::vector<std::pair<std::string, std::string>> drawn;  // (file, caption)
+    std::vector<std::string> plot_names;
+    for (const auto& [name, plot] : output.plots) {
+        try {
+            if (std::find(plot_names.begin(), plot_names.end(), name) != plot_names.end())
+                throw Error("plot '" + name + "'", "duplicate plot name");
+            plot_names.push_back(name);
+            std::string file = write_svg_plot(plot, context.output_dir, name);
+            drawn.emplace_back(file, plot.title.empty() ? name : plot.title);
+            if (std::find(output.files.begin(), output.files.end(), file) == output.files.end()) output.files.push_back(file);
+        } catch (const Error& e) {
+            output.notes.push_back("Plot " + name + " was not drawn: " + e.what());
+            context.say("plot " + name + " not drawn: " + e.what());
+        }
+    }
 
     nlohmann::json doc;
     doc["experiment"] = experiment.name;
@@ -71,6 +103,7 @@ ExperimentOutput run_and_write(const Experiment& experiment, ExperimentContext c
        << "every other figure was measured by this run.\n\n";
     if (context.quick) md << "**Quick run**: reduced sizes for a smoke check; figures are not comparable to the paper's.\n\n";
     for (const auto& t : output.tables) md << to_markdown(t) << "\n";
+    for (const auto& [file, caption] : drawn) md << "![" << markdown_alt_text(caption) << "](" << file << ")\n\n";
     for (const auto& note : output.notes) md << "- " << note << "\n";
     md << "\nWall time " << seconds << " s.\n";
 

@@ -6,9 +6,11 @@
 #include <functional>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 #include <nlohmann/json.hpp>
 #include "core/asset_paths.hpp"
+#include "experiments/plot.hpp"
 
 namespace gilab {
 
@@ -35,6 +37,9 @@ struct ExperimentOutput {
     nlohmann::json config = nlohmann::json::object();  // effective configuration
     std::vector<std::string> notes;      // printed under the tables in table.md
     std::vector<std::string> files;      // extra outputs written (images), relative names
+    // Figures as (name, plot): the runner draws each as NAME.svg, adds it to files and
+    // shows it in table.md.
+    std::vector<std::pair<std::string, Plot>> plots;
 };
 
 struct Experiment {
@@ -57,7 +62,9 @@ private:
 };
 
 // Runs the experiment and writes results.csv, results.json (figures, configuration, git
-// revision, seed, machine) and table.md into context.output_dir. Returns the output.
+// revision, seed, machine), table.md and one SVG per plot into context.output_dir.
+// A plot that cannot be drawn (no gnuplot) becomes a note instead of failing the run.
+// Returns the output.
 ExperimentOutput run_and_write(const Experiment& experiment, ExperimentContext context);
 
 // Registration functions, one per paper/module (called from registry.cpp only).
@@ -65,6 +72,7 @@ void register_core_experiments(ExperimentRegistry& registry);
 void register_photon_experiments(ExperimentRegistry& registry);    // P1: pm-table1..4, pm-fig8
 void register_stereo_experiments(ExperimentRegistry& registry);    // P1: pm-table5, pm-final, pm-foveated
 void register_dag_experiments(ExperimentRegistry& registry);       // P2: dag-table1..3, dag-fig13
+void register_shadow_dag_experiments(ExperimentRegistry& registry);  // P2: dag-table4, dag-fig15, dag-fig16-18
 void register_vct_experiments(ExperimentRegistry& registry);       // P3: vct-table1..7, vct-fig9..13, vct-stability
 
 }  // namespace gilab

@@ -82,7 +82,8 @@ int write_html_report(const fs::path& results_root) {
         }
         for (const auto& f : doc.value("files", nlohmann::json::array())) {
             std::string file = f.get<std::string>();
-            if (file.size() > 4 && file.substr(file.size() - 4) == ".png")
+            std::string extension = fs::path(file).extension().string();
+            if (extension == ".png" || extension == ".svg")
                 html << "<figure><img src=\"" << escape(name + "/" + file) << "\"><figcaption>" << escape(file)
                      << "</figcaption></figure>\n";
         }
