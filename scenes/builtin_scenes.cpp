@@ -2,6 +2,7 @@
 
 #include <array>
 #include <map>
+#include "scenes/shadow_scenes.hpp"
 
 namespace gilab {
 
@@ -156,6 +157,10 @@ const std::vector<BuiltinScene>& builtin_scenes() {
         {"cornell", "Cornell box (original measurements, unit scale) with its ceiling area light", make_cornell_box},
         {"furnace", "white furnace: inside a closed sphere, albedo 0.5, emission 1 (radiance 2 everywhere)",
          [] { return make_furnace_sphere(0.5f, 1.0f); }},
+        {"villa", "walled villa, ~40 m (walls, gate, towers, keep, gable roofs) on a slab; every mesh closed; sun",
+         make_villa},
+        {"fbm_terrain", "open 256x256 ridged-fBm heightfield, 200 m across, 25 m amplitude; low sun",
+         [] { return make_fbm_terrain(); }},
     };
     return scenes;
 }
