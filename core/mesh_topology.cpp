@@ -82,18 +82,26 @@ MeshTopology analyze_topology(const Mesh& mesh) {
         weld[i] = uint32_t(it->second);
     }
     std::vector<std::vector<size_t>> polygons;
+    std::vector<size_t> source_triangle;  // polygon → input triangle
     polygons.reserve(mesh.triangles.size());
-    for (const UVec3& t : mesh.triangles) {
+    for (size_t i = 0; i < mesh.triangles.size(); ++i) {
+        const UVec3& t = mesh.triangles[i];
         if (t.x >= weld.size() || t.y >= weld.size() || t.z >= weld.size()) continue;
         size_t a = weld[t.x], b = weld[t.y], c = weld[t.z];
         if (a == b || b == c || a == c) continue;  // collapsed by welding
         polygons.push_back({a, b, c});
+        source_triangle.push_back(i);
     }
     MeshTopology topo;
+    topo.closed_component.assign(mesh.triangles.size(), -1);
     if (polygons.empty()) return topo;
 
     const bool manifold = PMP::orient_polygon_soup(points, polygons);
-    if (!PMP::is_polygon_soup_a_polygon_mesh(polygons)) return soup_topology(polygons);
+    if (!PMP::is_polygon_soup_a_polygon_mesh(polygons)) {
+        MeshTopology soup = soup_topology(polygons);
+        soup.closed_component = std::move(topo.closed_component);
+        return soup;
+    }
 
     SurfaceMesh sm;
     PMP::polygon_soup_to_polygon_mesh(points, polygons, sm);
@@ -102,6 +110,18 @@ MeshTopology analyze_topology(const Mesh& mesh) {
     auto component = sm.add_property_map<SurfaceMesh::Face_index, size_t>("f:component", 0).first;
     topo.connected_components = PMP::connected_components(sm, component);
     topo.closed = manifold && topo.boundary_edges == 0 && CGAL::is_closed(sm);
+    // A component is closed when none of its faces borders a hole. Faces are numbered
+    // in polygon order by polygon_soup_to_polygon_mesh.
+    std::vector<uint8_t> open(topo.connected_components, 0);
+    for (auto h : sm.halfedges())
+        if (sm.is_border(h)) open[component[sm.face(sm.opposite(h))]] = 1;
+    if (sm.number_of_faces() == polygons.size()) {
+        for (auto f : sm.faces()) {
+            const size_t c = component[f];
+            if (!open[c]) topo.closed_component[source_triangle[size_t(f)]] = int32_t(c);
+        }
+        for (uint8_t o : open) topo.closed_components += o == 0;
+    }
     return topo;
 }
 

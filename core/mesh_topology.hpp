@@ -1,5 +1,7 @@
 #pragma once
 // Mesh checks done with CGAL: whether a triangle mesh is closed (watertight 2-manifold).
+#include <cstdint>
+#include <vector>
 #include "core/mesh.hpp"
 
 namespace gilab {
@@ -8,6 +10,13 @@ struct MeshTopology {
     bool closed = false;          // every edge shared by exactly two faces, consistently
     size_t boundary_edges = 0;
     size_t connected_components = 0;
+    // Components closed on their own (a model of many closed parts, like a building of
+    // separate walls and towers, is open as a whole while each part is closed).
+    size_t closed_components = 0;
+    // Per input triangle: the index of its edge-connected component when that component
+    // is closed, else -1 (an open component, a triangle collapsed by welding, or a soup
+    // CGAL cannot turn into a mesh).
+    std::vector<int32_t> closed_component;
 };
 
 MeshTopology analyze_topology(const Mesh& mesh);

@@ -1,5 +1,6 @@
 #include "core/stats.hpp"
 
+#include <malloc.h>
 #include <fstream>
 #include <sstream>
 
@@ -39,5 +40,17 @@ size_t read_status_kib(const char* field) {
 
 size_t peak_rss_bytes() { return read_status_kib("VmHWM") * 1024; }
 size_t current_rss_bytes() { return read_status_kib("VmRSS") * 1024; }
+
+bool reset_peak_rss() {
+    malloc_trim(0);  // give freed heap back first so the baseline is what is really held
+    {
+        std::ofstream f("/proc/self/clear_refs");
+        if (!f) return false;
+        f << "5";
+        f.flush();
+        if (!f) return false;
+    }
+    return peak_rss_bytes() <= current_rss_bytes() + (size_t(4) << 20);
+}
 
 }  // namespace gilab

@@ -50,5 +50,9 @@ private:
 
 size_t peak_rss_bytes();      // VmHWM of this process
 size_t current_rss_bytes();   // VmRSS of this process
+// Resets this process's peak-RSS mark (VmHWM) to its current RSS, so a peak read after a
+// piece of work is that work's own peak (plus what the process already held). Linux does
+// this on writing "5" to /proc/self/clear_refs. Returns false if the mark did not move.
+bool reset_peak_rss();
 
 }  // namespace gilab

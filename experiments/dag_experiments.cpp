@@ -1,7 +1,6 @@
 // P2 (sparse voxel DAGs): node and pointer totals (Table 1), storage (Table 2), SVO→SVDAG
 // conversion time (Table 3) and primary-ray traversal (Fig. 13) on the Stanford models,
 // with OpenVDB and OctoMap built from the same voxels as reference structures.
-#include <malloc.h>
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -168,21 +167,6 @@ double mb(double bytes) { return bytes / 1e6; }
 double mib(double bytes) { return bytes / double(1 << 20); }
 json ratio(double a, double b) { return b > 0 ? json(a / b) : json(nullptr); }
 std::string cube(uint32_t n) { return std::to_string(n) + "³"; }
-
-// Resets this process's peak-RSS mark (VmHWM) to its current RSS, so the peak read after
-// a row is that row's own peak (plus what the process already held). Linux does this on
-// writing "5" to /proc/self/clear_refs. Returns false if the mark did not move.
-bool reset_peak_rss() {
-    malloc_trim(0);  // give freed heap back first so the baseline is what is really held
-    {
-        std::ofstream f("/proc/self/clear_refs");
-        if (!f) return false;
-        f << "5";
-        f.flush();
-        if (!f) return false;
-    }
-    return peak_rss_bytes() <= current_rss_bytes() + (size_t(4) << 20);
-}
 
 // 1-minute load average when a timed experiment starts: other work on a shared machine
 // slows timings, and this says how much was running.

@@ -254,7 +254,8 @@ std::string describe_scene(const std::string& spec, const AssetPaths& assets) {
         MeshTopology topo = analyze_topology(s.meshes[i]);
         out << "  " << i << " " << (s.meshes[i].name.empty() ? "(unnamed)" : s.meshes[i].name) << ": "
             << s.meshes[i].triangles.size() << " triangles, " << (topo.closed ? "closed" : "open") << ", "
-            << topo.boundary_edges << " boundary edges, " << topo.connected_components << " components\n";
+            << topo.boundary_edges << " boundary edges, " << topo.connected_components << " components ("
+            << topo.closed_components << " closed)\n";
     }
     for (const auto& w : opened.warnings) out << "note         " << w << "\n";
     return out.str();

@@ -1,6 +1,7 @@
 #include "techniques/technique.hpp"
 
 #include "core/error.hpp"
+#include "techniques/dag_shadows/dag_shadows_technique.hpp"
 #include "techniques/path_tracer/path_tracer.hpp"
 #include "techniques/photon_mapping/photon_technique.hpp"
 #include "techniques/vct/vct_technique.hpp"
@@ -34,6 +35,7 @@ const TechniqueRegistry& TechniqueRegistry::builtin() {
         register_path_tracer(r);
         register_photon_mapping(r);
         register_vct(r);
+        register_dag_shadows(r);
         return r;
     }();
     return registry;
