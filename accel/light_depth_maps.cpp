@@ -18,30 +18,46 @@ Vec3 face_normal(const WorldMesh& mesh, uint32_t triangle) {
 // (interpenetrating meshes); past it the texel is treated as open.
 constexpr int kMaxExitSteps = 16;
 
+// Sign of (outward normal · ray direction): < 0 entering the part, > 0 leaving it.
+float facing(const SceneFrame& frame, const ClosedSurfaces& closed, const Hit& h, const Vec3& direction) {
+    const Vec3 n = face_normal(frame.meshes[h.mesh], h.triangle) * float(closed.outward[h.mesh][h.triangle]);
+    return glm::dot(n, direction);
+}
+
 }  // namespace
 
 ClosedSurfaces closed_surfaces(const Scene& scene, const SceneFrame& frame) {
     std::vector<std::optional<MeshTopology>> topology(scene.meshes.size());
     ClosedSurfaces out;
     out.component.resize(frame.meshes.size());
-    out.orientation.resize(frame.meshes.size());
+    out.outward.resize(frame.meshes.size());
     for (size_t m = 0; m < frame.meshes.size(); ++m) {
         const WorldMesh& wm = frame.meshes[m];
         std::optional<MeshTopology>& topo = topology.at(wm.source_mesh);
         if (!topo) topo = analyze_topology(scene.meshes[wm.source_mesh]);
         if (topo->closed_components == 0 || topo->closed_component.size() != wm.triangles.size()) continue;
-        out.component[m] = topo->closed_component;
-        // Signed volume per component decides which side is outside.
+        // World volume of each part with CGAL's consistent winding: its sign says which
+        // way that winding faces.
         std::vector<double> volume(topo->connected_components, 0.0);
         for (size_t t = 0; t < wm.triangles.size(); ++t) {
             const int32_t c = topo->closed_component[t];
             if (c < 0) continue;
             const UVec3 tri = wm.triangles[t];
             const DVec3 a(wm.positions[tri.x]), b(wm.positions[tri.y]), cc(wm.positions[tri.z]);
-            volume[size_t(c)] += glm::dot(a, glm::cross(b, cc));
+            volume[size_t(c)] += topo->winding[t] * glm::dot(a, glm::cross(b, cc));
         }
-        out.orientation[m].resize(volume.size());
-        for (size_t c = 0; c < volume.size(); ++c) out.orientation[m][c] = volume[c] > 0 ? 1 : (volume[c] < 0 ? -1 : 0);
+        out.component[m] = topo->closed_component;
+        out.outward[m].assign(wm.triangles.size(), 0);
+        for (size_t t = 0; t < wm.triangles.size(); ++t) {
+            const int32_t c = topo->closed_component[t];
+            if (c < 0) continue;
+            const double v = volume[size_t(c)];
+            if (v == 0) {
+                out.component[m][t] = -1;  // a flat "closed" part has no inside
+                continue;
+            }
+            out.outward[m][t] = int8_t(topo->winding[t] * (v > 0 ? 1 : -1));
+        }
         out.closed_components += topo->closed_components;
     }
     return out;
@@ -80,21 +96,21 @@ void LightDepthTile::render(const RayTracer& tracer, const LightSpace& space, co
                 const int32_t part = closed->component[h.mesh][h.triangle];
                 if (part < 0) continue;
                 // Entered through the outside? The face must face the light.
-                const int8_t side = closed->orientation[h.mesh][size_t(part)];
-                const Vec3 nrm = face_normal(frame.meshes[h.mesh], h.triangle) * float(side);
-                if (side == 0 || glm::dot(nrm, rays[i].direction) >= 0) continue;
+                if (facing(frame, *closed, h, rays[i].direction) >= 0) continue;
                 Ray exit_ray = rays[i];
                 float t = h.t;
                 for (int step = 0; step < kMaxExitSteps; ++step) {
                     exit_ray.tmin = t + std::max(1e-4f, t * 1e-6f);
                     const Hit e = tracer.intersect(exit_ray);
                     ++cast;
-                    if (!e.valid()) break;  // leaked out of a mesh CGAL called closed: treat as open
+                    if (!e.valid()) break;  // slipped out of the part unseen: leave the texel open
                     t = e.t;
-                    if (e.mesh == h.mesh && closed->component[e.mesh][e.triangle] == part) {
-                        d2[i] = e.t;
-                        break;
-                    }
+                    if (e.mesh != h.mesh || closed->component[e.mesh][e.triangle] != part) continue;
+                    // The exit is a face of the same part turned away from the light; a
+                    // face turned toward it means the real exit was missed (a ray through
+                    // a shared edge): leave the texel open rather than guess.
+                    if (facing(frame, *closed, e, rays[i].direction) > 0) d2[i] = e.t;
+                    break;
                 }
             }
             row_rays[row] = cast;

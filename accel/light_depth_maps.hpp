@@ -20,11 +20,13 @@ namespace gilab {
 
 // The closed surfaces of a frame, per connected component of each mesh (CGAL's check on
 // the source mesh): a model of many closed parts counts part by part. For each world
-// mesh, the closed component of every triangle (−1: open) and, per component, whether
-// its triangles wind outward (+1) or inward (−1) in world space, by signed volume.
+// mesh, the closed component of every triangle (−1: open) and whether the triangle's
+// own winding faces out of its part (+1) or into it (−1) in world space: CGAL's
+// consistent orientation of the part, turned outward by the sign of its world volume
+// (which also undoes a mirroring transform).
 struct ClosedSurfaces {
-    std::vector<std::vector<int32_t>> component;     // [mesh][triangle]; empty: no closed part
-    std::vector<std::vector<int8_t>> orientation;    // [mesh][component]
+    std::vector<std::vector<int32_t>> component;  // [mesh][triangle]; empty: no closed part
+    std::vector<std::vector<int8_t>> outward;     // [mesh][triangle]
     size_t closed_components = 0;
     bool empty() const { return closed_components == 0; }
 };

@@ -36,7 +36,7 @@ public:
     // Continuous light-space coordinates of a world point (may fall outside [0, N)).
     DVec3 to_light(const Vec3& p) const;
     // Where a surface point is looked up: moved off the surface along its normal
-    // (turned to face the light) by 1.5 voxels, then 1 voxel toward the light, so that a
+    // (turned to face the light; callers skip surfaces turned away) by 1.5 voxels, then 1 voxel toward the light, so that a
     // lit surface does not shadow itself through depth quantization ("acne"). Both the
     // shadow map and the shadow DAGs look up this same point.
     DVec3 lookup_coords(const Vec3& p, const Vec3& normal) const;
@@ -44,6 +44,14 @@ public:
     float voxel_world_size(const Vec3& p) const;
     // Unit direction from p toward the light.
     Vec3 to_light_direction(const Vec3& p) const;
+    // Whether a surface with this normal at p is turned toward the light. One turned
+    // away is unlit by its own object, whatever a structure would answer.
+    bool faces_light(const Vec3& p, const Vec3& normal) const { return glm::dot(normal, to_light_direction(p)) > 0; }
+    // Unit axes of the grid in world space: across the beam (x, y) and along it (z); for
+    // a spot light, those of its central axis.
+    const Vec3& axis_x() const { return right_; }
+    const Vec3& axis_y() const { return up_; }
+    const Vec3& axis_z() const { return dir_; }
 
 private:
     uint32_t n_ = 0;

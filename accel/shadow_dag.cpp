@@ -6,11 +6,14 @@
 #include "core/error.hpp"
 #include "core/morton.hpp"
 #include "core/parallel.hpp"
+#include "core/stats.hpp"
 
 namespace gilab {
 namespace {
 
 constexpr uint32_t kDefaultTile = 2048;
+constexpr int kMaxSplitLevel = 6;
+constexpr uint32_t kProbeResolution = 512;
 
 // Merges cell SVOs bottom-up into the shared per-level tables and joins the cells.
 class ShadowDagMerger {
@@ -69,17 +72,28 @@ private:
 
 }  // namespace
 
-ShadowDag ShadowDag::build(int grid_depth, uint32_t tile_texels, const TileFill& fill,
-                           const std::function<void(double)>& progress, ShadowState undefined_as) {
+ShadowDag ShadowDag::build(int grid_depth, const TileFill& fill, const ShadowDagOptions& options) {
     Stopwatch clock;
     if (grid_depth < 3 || grid_depth > 17)
         throw Error("shadow DAG", "light-space octree depth " + std::to_string(grid_depth) + " is outside 3..17");
+    const ShadowState undefined_as = options.undefined_as;
     const uint32_t size = 1u << grid_depth;
-    const uint32_t tile = tile_texels == 0 ? std::min(size, kDefaultTile) : tile_texels;
+    const uint32_t tile = options.tile_texels == 0 ? std::min(size, kDefaultTile) : options.tile_texels;
     if (tile < 4 || tile > size || (tile & (tile - 1)))
         throw Error("shadow DAG", "tile size " + std::to_string(tile) + " must be a power of two in 4.." +
                                       std::to_string(size));
     const int split = grid_depth - __builtin_ctz(tile);  // level of the tile-sized cells
+    // Cells are kept as one state and id each, 8^split of them: at most 2^18.
+    if (split > kMaxSplitLevel)
+        throw Error("shadow DAG", "tile size " + std::to_string(tile) + " is too small for a " + std::to_string(size) +
+                                      "³ octree: at least " + std::to_string(size >> kMaxSplitLevel));
+    const size_t limit = options.memory_limit_bytes ? options.memory_limit_bytes : default_memory_limit_bytes();
+    // A depth tile holds two float pyramids (4/3 of the texels each).
+    const size_t tile_bytes = size_t(tile) * tile * 2 * sizeof(float) * 4 / 3;
+    if (tile_bytes > limit)
+        throw Error("shadow DAG", "a " + std::to_string(tile) + "² depth tile needs " + std::to_string(tile_bytes / 1000000) +
+                                      " MB, over the " + std::to_string(limit / 1000000) + " MB memory limit");
+    const auto& progress = options.progress;
     const uint32_t cells_per_axis = 1u << split;
 
     ShadowDag dag;
@@ -115,6 +129,11 @@ ShadowDag ShadowDag::build(int grid_depth, uint32_t tile_texels, const TileFill&
             }
             ++st.tiles;
             if (progress) progress(double(st.tiles) / (double(cells_per_axis) * cells_per_axis));
+            if (merger.table_bytes() + tile_bytes > limit)
+                throw Error("shadow DAG", "the merge tables outgrew the " + std::to_string(limit / 1000000) +
+                                              " MB memory limit after " + std::to_string(st.tiles) + " of " +
+                                              std::to_string(size_t(cells_per_axis) * cells_per_axis) +
+                                              " tiles; use a lower resolution");
         }
 
     // Join the cells under the root, level by level, by the same rules.
@@ -158,17 +177,25 @@ ShadowDag ShadowDag::build(int grid_depth, uint32_t tile_texels, const TileFill&
 
 ShadowDag ShadowDag::build(const Scene& scene, const RayTracer& tracer, const PunctualLight& light,
                            const ShadowDagOptions& options) {
-    LightSpace space(light, tracer.frame().bounds, options.resolution);
+    const LightSpace space(light, tracer.frame().bounds, options.resolution);
+    {
+        // A coarse look first, so a light that sees nothing is refused at once.
+        const LightSpace probe(light, tracer.frame().bounds, kProbeResolution);
+        LightDepthTile t;
+        t.render(tracer, probe, nullptr, 0, 0, kProbeResolution);
+        if (!t.any_hit())
+            throw Error("shadow DAG (light '" + light.name + "')",
+                        "the light sees no geometry in its view volume (probed at 512² rays)");
+    }
+    Stopwatch closed_clock;
     const ClosedSurfaces closed = options.double_depth ? closed_surfaces(scene, tracer.frame()) : ClosedSurfaces{};
-    bool any_hit = false;
-    ShadowDag dag = build(space.depth(), options.tile_texels,
-                          [&](uint32_t x0, uint32_t y0, uint32_t size, LightDepthTile& tile) {
-                              tile.render(tracer, space, &closed, x0, y0, size);
-                              any_hit |= tile.any_hit();
-                          },
-                          options.progress, options.undefined_as);
-    if (!any_hit)
-        throw Error("shadow DAG (light '" + light.name + "')", "the light sees no geometry in its view volume");
+    const double closed_ms = closed_clock.elapsed_ms();
+    ShadowDag dag = build(
+        space.depth(),
+        [&](uint32_t x0, uint32_t y0, uint32_t size, LightDepthTile& tile) { tile.render(tracer, space, &closed, x0, y0, size); },
+        options);
+    dag.stats_.closed_ms = closed_ms;
+    dag.stats_.total_ms += closed_ms;
     dag.space_ = space;
     return dag;
 }
@@ -179,33 +206,45 @@ size_t ShadowDag::node_count() const {
     return n;
 }
 
-ShadowState ShadowDag::voxel_state(const UVec3& v) const {
+ShadowState ShadowDag::voxel_state(const UVec3& v, Cursor& cur) const {
     if (root_state_ != ShadowState::Boundary) return root_state_;
     const int leaf_level = depth_ - kShadowLeafLevels;
-    uint32_t node = 0;
-    for (int level = 0; level < leaf_level; ++level) {
+    // The node on level k depends only on the top k bits of each coordinate: restart from
+    // the deepest level above the highest bit in which this voxel differs from the last.
+    const uint32_t diff = (v.x ^ cur.voxel.x) | (v.y ^ cur.voxel.y) | (v.z ^ cur.voxel.z);
+    const int same = diff == 0 ? leaf_level : std::min(leaf_level, depth_ - 1 - (31 - __builtin_clz(diff)));
+    int level = std::min(same, cur.levels - 1);
+    uint32_t node = cur.node[level];
+    cur.voxel = v;
+    for (; level < leaf_level; ++level) {
         const int bit = depth_ - 1 - level;
         const int slot = int((v.x >> bit) & 1u) | int((v.y >> bit) & 1u) << 1 | int((v.z >> bit) & 1u) << 2;
         const uint32_t mask = words_[node] & 0xffffu;
         const ShadowState s = child_state(mask, slot);
-        if (s != ShadowState::Boundary) return s;
+        if (s != ShadowState::Boundary) {
+            cur.levels = level + 1;
+            return s;
+        }
         node = words_[node + 1 + boundary_rank(mask, slot)];
+        cur.node[level + 1] = node;
     }
+    cur.levels = leaf_level + 1;
     const uint64_t bits = uint64_t(words_[node]) | uint64_t(words_[node + 1]) << 32;
     const uint32_t k = (v.x & 3u) + 4 * (v.y & 3u) + 16 * (v.z & 3u);
     return (bits >> k) & 1u ? ShadowState::Shadow : ShadowState::Lit;
 }
 
-bool ShadowDag::lit_at(const DVec3& c) const {
+bool ShadowDag::lit_at(const DVec3& c, Cursor& cursor) const {
     const double n = space_ ? double(space_->resolution()) : double(octree_size());
     if (!(c.x >= 0 && c.y >= 0 && c.x < n && c.y < n) || !(c.z >= 0)) return true;
     const uint32_t z = uint32_t(std::min(c.z, double(octree_size() - 1)));
-    return state_is_lit(voxel_state(UVec3(uint32_t(c.x), uint32_t(c.y), z)));
+    return state_is_lit(voxel_state(UVec3(uint32_t(c.x), uint32_t(c.y), z), cursor));
 }
 
-float ShadowDag::visibility(const Vec3& p, const Vec3& normal, int pcf) const {
+float ShadowDag::visibility(const Vec3& p, const Vec3& normal, int pcf, Cursor& cursor) const {
     if (!space_) throw Error("shadow DAG", "world lookups need a DAG built from a scene");
-    return pcf_visibility(space_->lookup_coords(p, normal), pcf, [&](const DVec3& c) { return lit_at(c); });
+    if (!space_->faces_light(p, normal)) return 0.0f;
+    return pcf_visibility(space_->lookup_coords(p, normal), pcf, [&](const DVec3& c) { return lit_at(c, cursor); });
 }
 
 void ShadowDag::visibility(std::span<const Vec3> points, std::span<const Vec3> normals, std::span<float> out,
@@ -213,7 +252,8 @@ void ShadowDag::visibility(std::span<const Vec3> points, std::span<const Vec3> n
     if (points.size() != normals.size() || points.size() != out.size())
         throw Error("shadow DAG", "batched lookup needs as many normals and outputs as points");
     parallel_for(points.size(), 4096, [&](size_t begin, size_t end) {
-        for (size_t i = begin; i < end; ++i) out[i] = visibility(points[i], normals[i], pcf);
+        Cursor cursor;  // points arrive in pixel order: neighbours share most of their path
+        for (size_t i = begin; i < end; ++i) out[i] = visibility(points[i], normals[i], pcf, cursor);
     });
 }
 
@@ -250,6 +290,7 @@ Stats ShadowDag::stats() const {
     s.set("pointers", double(pointer_count_));
     s.set("bytes", double(bytes()));
     s.set("total_ms", stats_.total_ms);
+    s.set("closed_ms", stats_.closed_ms);
     s.set("depth_ms", stats_.depth_ms);
     s.set("svo_ms", stats_.svo_ms);
     s.set("merge_ms", stats_.merge_ms);

@@ -13,6 +13,7 @@
 // tiles; for each tile the depth maps are rendered, each cell of the tile's column
 // becomes a ShadowSvo that is merged into the shared level tables and dropped, and the
 // cells are joined under the root by the same rules. The full SVO is never held.
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -36,10 +37,12 @@ struct ShadowDagOptions {
     // Shadow; see ShadowSvo). Without closed geometry there is none and it changes nothing.
     ShadowState undefined_as = ShadowState::Lit;
     std::function<void(double)> progress;  // fraction of tiles done, may be empty
+    size_t memory_limit_bytes = 0;         // depth tiles and merge tables; 0 = half the RAM
 };
 
 struct ShadowDagBuildStats {
     double total_ms = 0;
+    double closed_ms = 0;      // deciding which parts are closed (CGAL), double depth only
     double depth_ms = 0;       // depth maps rendered with Embree
     double svo_ms = 0;         // 3-state SVOs of the cells
     double merge_ms = 0;       // bottom-up identical-node merge (hash and look up)
@@ -60,11 +63,10 @@ public:
     static ShadowDag build(const Scene& scene, const RayTracer& tracer, const PunctualLight& light,
                            const ShadowDagOptions& options);
     // Builds from depth tiles given by `fill` (tests, or depth maps from elsewhere):
-    // fill(x0, y0, size, tile) must fill the tile for that texel square.
+    // fill(x0, y0, size, tile) must fill the tile for that texel square. Of `options`,
+    // resolution is ignored (the grid is 2^grid_depth) and the rest apply.
     using TileFill = std::function<void(uint32_t x0, uint32_t y0, uint32_t size, LightDepthTile& tile)>;
-    static ShadowDag build(int grid_depth, uint32_t tile_texels, const TileFill& fill,
-                           const std::function<void(double)>& progress = {},
-                           ShadowState undefined_as = ShadowState::Lit);
+    static ShadowDag build(int grid_depth, const TileFill& fill, const ShadowDagOptions& options);
 
     int depth() const { return depth_; }
     uint32_t octree_size() const { return 1u << depth_; }
@@ -79,14 +81,36 @@ public:
     uint64_t pointer_count() const { return pointer_count_; }
     const std::vector<uint64_t>& level_node_counts() const { return level_counts_; }  // levels 0..leaf
 
-    // State of one voxel (Lit, Shadow or Undefined), by descending from the root: O(depth).
-    ShadowState voxel_state(const UVec3& voxel) const;
+    // A lookup's path, kept between lookups: the next one restarts from the deepest node
+    // both voxels share, so coherent lookups (neighbouring pixels) skip the top levels.
+    // The answer never depends on it. One per thread.
+    struct Cursor {
+        UVec3 voxel{0};
+        int levels = 1;                   // node[0 .. levels-1] hold the path to `voxel`
+        std::array<uint32_t, 18> node{};  // word address per level; node[0] is the root
+    };
+
+    // State of one voxel (Lit, Shadow, or Undefined where a whole node is undefined), by
+    // descending from the root: O(depth).
+    ShadowState voxel_state(const UVec3& voxel) const {
+        Cursor fresh;
+        return voxel_state(voxel, fresh);
+    }
+    ShadowState voxel_state(const UVec3& voxel, Cursor& cursor) const;
     // The answer for light-space coordinates: lit outside the grid's x–y square and in
     // front of it; past its far end the last layer answers.
-    bool lit_at(const DVec3& light_coords) const;
+    bool lit_at(const DVec3& light_coords) const {
+        Cursor fresh;
+        return lit_at(light_coords, fresh);
+    }
+    bool lit_at(const DVec3& light_coords, Cursor& cursor) const;
     // World surface point with its normal (needs the light space of a scene build);
     // pcf = k > 1 averages k×k neighbouring columns (percentage-closer filtering).
-    float visibility(const Vec3& p, const Vec3& normal, int pcf = 1) const;
+    float visibility(const Vec3& p, const Vec3& normal, int pcf = 1) const {
+        Cursor fresh;
+        return visibility(p, normal, pcf, fresh);
+    }
+    float visibility(const Vec3& p, const Vec3& normal, int pcf, Cursor& cursor) const;
     // A frame's hit points at once, in parallel.
     void visibility(std::span<const Vec3> points, std::span<const Vec3> normals, std::span<float> out,
                     int pcf = 1) const;

@@ -1,5 +1,4 @@
 #include "accel/shadow_map.hpp"
-#include <unistd.h>
 #include <algorithm>
 #include <cmath>
 #include "accel/light_depth_maps.hpp"
@@ -9,12 +8,6 @@
 #include "core/stats.hpp"
 
 namespace gilab {
-
-size_t default_memory_limit_bytes() {
-    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-    if (pages <= 0 || page <= 0) return size_t(8) << 30;
-    return size_t(pages) * size_t(page) / 2;
-}
 
 ShadowMap ShadowMap::build(const RayTracer& tracer, const PunctualLight& light, uint32_t resolution, int bits,
                            size_t memory_limit_bytes) {
@@ -31,8 +24,7 @@ ShadowMap ShadowMap::build(const RayTracer& tracer, const PunctualLight& light, 
     const size_t texels = size_t(resolution) * resolution;
     if (bits == 32) map.depth32_.assign(texels, kInfinity);
     else map.depth16_.assign(texels, 0xffff);
-    const uint32_t octree = space.octree_size();
-    const uint32_t tile = std::min(octree, 1024u);
+    const uint32_t tile = std::min(space.octree_size(), 1024u);
     LightDepthTile t;
     for (uint32_t y0 = 0; y0 < resolution; y0 += tile)
         for (uint32_t x0 = 0; x0 < resolution; x0 += tile) {
@@ -44,8 +36,8 @@ ShadowMap ShadowMap::build(const RayTracer& tracer, const PunctualLight& light, 
                     if (bits == 32) {
                         map.depth32_[i] = d;
                     } else if (d < kInfinity) {
-                        // Fixed point over [0, octree size): rounded to nearest, 65535 reserved.
-                        map.depth16_[i] = uint16_t(std::clamp(std::lround(d / octree * 65535.0), 0l, 65534l));
+                        // Fixed point over [0, N), rounded up; 65535 means nothing hit.
+                        map.depth16_[i] = uint16_t(std::clamp(std::ceil(double(d) / resolution * 65535.0), 0.0, 65534.0));
                     }
                 }
         }
@@ -56,7 +48,7 @@ ShadowMap ShadowMap::build(const RayTracer& tracer, const PunctualLight& light, 
 float ShadowMap::depth(uint32_t x, uint32_t y) const {
     const size_t i = size_t(y) * space_.resolution() + x;
     if (bits_ == 32) return depth32_[i];
-    return depth16_[i] == 0xffff ? kInfinity : float(depth16_[i] / 65535.0 * space_.octree_size());
+    return depth16_[i] == 0xffff ? kInfinity : float(depth16_[i] / 65535.0 * space_.resolution());
 }
 
 bool ShadowMap::lit_at(const DVec3& c) const {
@@ -66,6 +58,7 @@ bool ShadowMap::lit_at(const DVec3& c) const {
 }
 
 float ShadowMap::visibility(const Vec3& p, const Vec3& normal, int pcf) const {
+    if (!space_.faces_light(p, normal)) return 0.0f;
     return pcf_visibility(space_.lookup_coords(p, normal), pcf, [&](const DVec3& c) { return lit_at(c); });
 }
 

@@ -2,13 +2,15 @@
 // The plain shadow map the paper compares with (S1 of Table 4): the first-hit depth D1
 // of every light-space texel, rendered with the same rays as the shadow DAG's depth
 // maps and looked up at the same biased point. Stored either as 32-bit floats or as
-// 16-bit fixed point over the grid's depth range (the two byte counts a shadow map is
-// usually given with).
+// 16-bit fixed point over the grid's depth range [0, N), rounded up so a stored depth is
+// never in front of the surface (the two byte counts a shadow map is usually given with;
+// one 16-bit step is N/65535 voxels, more than half a voxel above N = 32768).
 #include <cstdint>
 #include <span>
 #include <vector>
 #include "accel/light_space.hpp"
 #include "core/ray_tracer.hpp"
+#include "core/stats.hpp"
 
 namespace gilab {
 
@@ -40,8 +42,5 @@ private:
     std::vector<uint16_t> depth16_;  // 65535 = nothing hit
     double build_ms_ = 0;
 };
-
-// Half the machine's physical memory: the default ceiling for allocations a setting asks for.
-size_t default_memory_limit_bytes();
 
 }  // namespace gilab

@@ -57,8 +57,9 @@ inline ShadowState stored_child_state(ShadowState s, ShadowState undefined_as) {
     return s == ShadowState::Undefined ? undefined_as : s;
 }
 
-// What a lookup that ends on a state answers: undefined space is read as lit, which is
-// where a biased lookup just below a closed object's lit surface lands.
+// What a lookup that ends on a state answers. Undefined space lies inside closed
+// objects; the only lookups that land there are of a lit surface whose bias fell short
+// of the depth quantization (grazing light), so it reads as lit.
 inline bool state_is_lit(ShadowState s) { return s != ShadowState::Shadow; }
 
 }  // namespace gilab

@@ -94,12 +94,15 @@ MeshTopology analyze_topology(const Mesh& mesh) {
     }
     MeshTopology topo;
     topo.closed_component.assign(mesh.triangles.size(), -1);
+    topo.winding.assign(mesh.triangles.size(), 0);
     if (polygons.empty()) return topo;
 
+    const std::vector<std::vector<size_t>> original = polygons;
     const bool manifold = PMP::orient_polygon_soup(points, polygons);
     if (!PMP::is_polygon_soup_a_polygon_mesh(polygons)) {
         MeshTopology soup = soup_topology(polygons);
         soup.closed_component = std::move(topo.closed_component);
+        soup.winding = std::move(topo.winding);
         return soup;
     }
 
@@ -117,8 +120,18 @@ MeshTopology analyze_topology(const Mesh& mesh) {
         if (sm.is_border(h)) open[component[sm.face(sm.opposite(h))]] = 1;
     if (sm.number_of_faces() == polygons.size()) {
         for (auto f : sm.faces()) {
-            const size_t c = component[f];
-            if (!open[c]) topo.closed_component[source_triangle[size_t(f)]] = int32_t(c);
+            const size_t c = component[f], k = size_t(f);
+            if (open[c]) continue;
+            topo.closed_component[source_triangle[k]] = int32_t(c);
+            // orient_polygon_soup reverses polygons in place (it may also split a point
+            // into copies at a non-manifold vertex, but then the component is open): the
+            // polygon kept its cyclic order or was reversed. Compare by the second corner
+            // after the first one's position in the original.
+            const auto& o = original[k];
+            const auto& p = polygons[k];
+            size_t at = 0;
+            while (at < 3 && points[o[at]] != points[p[0]]) ++at;
+            topo.winding[source_triangle[k]] = (at < 3 && points[o[(at + 1) % 3]] == points[p[1]]) ? 1 : -1;
         }
         for (uint8_t o : open) topo.closed_components += o == 0;
     }

@@ -17,6 +17,10 @@ struct MeshTopology {
     // is closed, else -1 (an open component, a triangle collapsed by welding, or a soup
     // CGAL cannot turn into a mesh).
     std::vector<int32_t> closed_component;
+    // Per input triangle: +1 if its winding agrees with the consistent orientation CGAL
+    // gave its component, −1 if CGAL had to reverse it (0 where closed_component is −1).
+    // Inside a closed component, triangles with the same sign wind the same way round.
+    std::vector<int8_t> winding;
 };
 
 MeshTopology analyze_topology(const Mesh& mesh);

@@ -1,6 +1,7 @@
 #include "core/stats.hpp"
 
 #include <malloc.h>
+#include <unistd.h>
 #include <fstream>
 #include <sstream>
 
@@ -40,6 +41,12 @@ size_t read_status_kib(const char* field) {
 
 size_t peak_rss_bytes() { return read_status_kib("VmHWM") * 1024; }
 size_t current_rss_bytes() { return read_status_kib("VmRSS") * 1024; }
+
+size_t default_memory_limit_bytes() {
+    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+    if (pages <= 0 || page <= 0) return size_t(8) << 30;
+    return size_t(pages) * size_t(page) / 2;
+}
 
 bool reset_peak_rss() {
     malloc_trim(0);  // give freed heap back first so the baseline is what is really held

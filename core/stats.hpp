@@ -54,5 +54,8 @@ size_t current_rss_bytes();   // VmRSS of this process
 // piece of work is that work's own peak (plus what the process already held). Linux does
 // this on writing "5" to /proc/self/clear_refs. Returns false if the mark did not move.
 bool reset_peak_rss();
+// Half the machine's physical memory: the default ceiling for what a setting may ask to
+// allocate, checked before allocating.
+size_t default_memory_limit_bytes();
 
 }  // namespace gilab

@@ -2,6 +2,9 @@
 // split by normals still count as closed, non-manifold soups are reported open without
 // crashing, and the real Cornell box is open.
 #include <gtest/gtest.h>
+#include <algorithm>
+#include <numeric>
+#include <random>
 
 #include "core/mesh_loaders.hpp"
 #include "core/mesh_topology.hpp"
@@ -128,4 +131,63 @@ TEST(MeshTopology, RealClosedModels) {
     } else {
         GTEST_SKIP() << "shared assets dragon/bunny not found";
     }
+}
+
+TEST(MeshTopology, ClosedPartsOfAnOpenMeshAreFoundTriangleByTriangle) {
+    // One mesh: a closed cube, a cube missing its top, and a second closed cube with one
+    // triangle wound the wrong way; triangles shuffled so order says nothing.
+    Mesh m = cube();
+    Mesh open = cube(Vec3(3, 0, 0));
+    open.triangles.erase(open.triangles.begin() + 6, open.triangles.begin() + 8);  // the +y face
+    Mesh flipped = cube(Vec3(0, 3, 0));
+    std::swap(flipped.triangles[5].y, flipped.triangles[5].z);
+    std::vector<int> part(m.triangles.size(), 0);
+    for (const Mesh* extra : {&open, &flipped}) {
+        const uint32_t base = uint32_t(m.positions.size());
+        m.positions.insert(m.positions.end(), extra->positions.begin(), extra->positions.end());
+        for (const UVec3& t : extra->triangles) m.triangles.push_back(t + UVec3(base));
+        part.insert(part.end(), extra->triangles.size(), extra == &open ? 1 : 2);
+    }
+    const size_t flipped_index = 12 + 10 + 5;
+    std::vector<size_t> order(m.triangles.size());
+    std::iota(order.begin(), order.end(), size_t(0));
+    std::mt19937 rng(3);
+    std::shuffle(order.begin(), order.end(), rng);
+    Mesh shuffled = m;
+    std::vector<int> shuffled_part(order.size());
+    size_t flipped_at = 0;
+    for (size_t i = 0; i < order.size(); ++i) {
+        shuffled.triangles[i] = m.triangles[order[i]];
+        shuffled_part[i] = part[order[i]];
+        if (order[i] == flipped_index) flipped_at = i;
+    }
+    shuffled.material_ids.assign(shuffled.triangles.size(), 0);
+
+    const MeshTopology t = analyze_topology(shuffled);
+    EXPECT_FALSE(t.closed);
+    EXPECT_EQ(t.connected_components, 3u);
+    EXPECT_EQ(t.closed_components, 2u);
+    int closed_id[3] = {-2, -2, -2};
+    for (size_t i = 0; i < shuffled.triangles.size(); ++i) {
+        const int c = t.closed_component[i];
+        if (shuffled_part[i] == 1) {
+            EXPECT_EQ(c, -1) << i;
+            EXPECT_EQ(t.winding[i], 0);
+            continue;
+        }
+        ASSERT_GE(c, 0) << i;
+        int& id = closed_id[shuffled_part[i]];
+        if (id == -2) id = c;
+        EXPECT_EQ(c, id) << "one part, one component";
+    }
+    EXPECT_NE(closed_id[0], closed_id[2]);
+    // Within each closed cube every triangle winds alike, except the one reversed.
+    int8_t first_of_part[3] = {0, 0, 0};
+    for (size_t i = 0; i < shuffled.triangles.size(); ++i) {
+        if (shuffled_part[i] == 1 || i == flipped_at) continue;
+        int8_t& f = first_of_part[shuffled_part[i]];
+        if (f == 0) f = t.winding[i];
+        EXPECT_EQ(t.winding[i], f) << i;
+    }
+    EXPECT_EQ(t.winding[flipped_at], -first_of_part[2]);
 }

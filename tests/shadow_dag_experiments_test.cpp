@@ -33,9 +33,10 @@ ExperimentOutput run_quick(const std::string& name) {
     ExperimentOutput out = run_and_write(shadow_registry().get(name), ctx);
     for (const char* file : {"results.csv", "results.json", "table.md"})
         EXPECT_TRUE(fs::exists(ctx.output_dir / file)) << name << ": " << file;
-    if (plotting_available())
+    if (plotting_available()) {
         for (const auto& [plot_name, plot] : out.plots)
             EXPECT_TRUE(fs::exists(ctx.output_dir / (plot_name + ".svg"))) << plot_name;
+    }
     EXPECT_FALSE(out.tables.empty());
     for (const ResultTable& t : out.tables) {
         EXPECT_FALSE(t.rows.empty()) << t.title;
@@ -76,12 +77,12 @@ TEST(ShadowDagExperiments, Table4Storage) {
         EXPECT_GT(s3, 0);
         EXPECT_LE(s3, s2 * 1.0001) << row.dump();  // folding undefined space never adds nodes
         EXPECT_NEAR(row["S2 bits/texel"].get<double>(), s2 * 1e6 * 8 / (n * n), 1e-9);
-        if (!row["paper S2 (MB)"].is_null()) EXPECT_NE(s2, row["paper S2 (MB)"].get<double>());
     }
     // The villa is all closed meshes: double depth maps save a lot; an open heightfield
     // has nothing closed, so S3 = S2 exactly.
     EXPECT_LT((*villa)["S3 / S2"].get<double>(), 0.8);
     EXPECT_DOUBLE_EQ((*terrain)["S3 / S2"].get<double>(), 1.0);
+    EXPECT_DOUBLE_EQ((*terrain)["S3, undefined as shadow (MB)"].get<double>(), (*terrain)["S3 (MB)"].get<double>());
 }
 
 TEST(ShadowDagExperiments, Fig15Growth) {
@@ -112,9 +113,10 @@ TEST(ShadowDagExperiments, Fig16To18ShadowTimes) {
         ++villa_rows;
         EXPECT_GT(row["shadow time per frame (ms)"].get<double>(), 0);
         const double differ = row["pixels differing from rays (%)"].get<double>();
-        EXPECT_GE(differ, 0);
         EXPECT_LT(differ, 5.0) << row.dump();  // at 512³ the structures agree with rays almost everywhere
-        if (row["visibility"] == "ray") EXPECT_EQ(differ, 0);
+        if (row["visibility"] == "ray") {
+            EXPECT_EQ(differ, 0);
+        }
         EXPECT_TRUE(row["paper vs shadow map (%)"].is_null());  // the paper's figure is for Citadel only
     }
     EXPECT_EQ(villa_rows, 4);

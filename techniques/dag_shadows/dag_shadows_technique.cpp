@@ -64,6 +64,10 @@ DagShadowsSettings DagShadowsSettings::from(const Settings& s) {
     if (tile < 0 || tile > int64_t(kMaxLightSpaceResolution) || (tile & (tile - 1)))
         throw Error(std::string(kName) + ".tile", "must be 0 (automatic) or a power of two");
     o.tile = uint32_t(tile);
+    const std::string undefined = s.get<std::string>("undefined_as", "lit");
+    if (undefined != "lit" && undefined != "shadow")
+        throw Error(std::string(kName) + ".undefined_as", "must be lit or shadow, not '" + undefined + "'");
+    o.undefined_as = undefined == "lit" ? ShadowState::Lit : ShadowState::Shadow;
     o.ambient = s.get<float>("ambient", o.ambient);
     if (!(o.ambient >= 0 && o.ambient <= 1)) throw Error(std::string(kName) + ".ambient", "must be in [0, 1]");
     o.tile_size = s.get<int>("tile_size", o.tile_size);
@@ -95,9 +99,16 @@ void DagShadowsTechnique::prepare(const Scene& scene, const Settings& settings) 
     stats_.set("prepare_ms", watch.elapsed_ms());
 }
 
+Stats DagShadowsTechnique::stats() const {
+    Stats out = stats_;
+    out.merge(structure_stats_);
+    return out;
+}
+
 void DagShadowsTechnique::build_structure() {
     dag_.reset();
     map_.reset();
+    structure_stats_ = Stats();
     const PunctualLight& l = light();
     Stopwatch watch;
     switch (settings_.visibility) {
@@ -105,7 +116,7 @@ void DagShadowsTechnique::build_structure() {
         case VisibilitySource::ShadowMap:
             map_ = std::make_unique<ShadowMap>(
                 ShadowMap::build(scene_.tracer(), l, settings_.resolution, settings_.shadow_map_bits));
-            stats_.set("structure_bytes", double(map_->bytes()));
+            structure_stats_.set("structure_bytes", double(map_->bytes()));
             break;
         case VisibilitySource::ShadowDag:
         case VisibilitySource::ShadowDagDoubleDepth: {
@@ -113,13 +124,14 @@ void DagShadowsTechnique::build_structure() {
             o.resolution = settings_.resolution;
             o.double_depth = settings_.visibility == VisibilitySource::ShadowDagDoubleDepth;
             o.tile_texels = settings_.tile;
+            o.undefined_as = settings_.undefined_as;
             dag_ = std::make_unique<ShadowDag>(ShadowDag::build(*source_, scene_.tracer(), l, o));
-            stats_.merge(dag_->stats(), "dag_");
-            stats_.set("structure_bytes", double(dag_->bytes()));
+            structure_stats_.merge(dag_->stats(), "dag_");
+            structure_stats_.set("structure_bytes", double(dag_->bytes()));
             break;
         }
     }
-    stats_.set("structure_build_ms", watch.elapsed_ms());
+    structure_stats_.set("structure_build_ms", watch.elapsed_ms());
 }
 
 void DagShadowsTechnique::update(double time) {
@@ -137,6 +149,7 @@ void DagShadowsTechnique::render(const ViewSet& views, std::vector<Film>& films)
     const auto& materials = scene_.materials();
     const PunctualLight& l = light();
     double shadow_ms = 0;
+    size_t lookups = 0;
     for (size_t v = 0; v < views.views.size(); ++v) {
         const EyeCamera& cam = views.views[v];
         const int w = cam.width(), h = cam.height();
@@ -176,6 +189,7 @@ void DagShadowsTechnique::render(const ViewSet& views, std::vector<Film>& films)
             index.push_back(i);
         }
         std::vector<float> vis(points.size(), 1.0f);
+        lookups += points.size();
         Stopwatch shadow_clock;
         if (dag_) {
             dag_->visibility(points, normals, vis, settings_.pcf);
@@ -229,6 +243,7 @@ void DagShadowsTechnique::render(const ViewSet& views, std::vector<Film>& films)
     for (Film& film : films) film.metadata["render_time_seconds"] = format_number(ms / 1000.0);
     stats_.set("render_ms", ms);
     stats_.set("shadow_ms", shadow_ms);
+    stats_.set("lookups", double(lookups));
 }
 
 void register_dag_shadows(TechniqueRegistry& registry) {

@@ -9,7 +9,8 @@
 // resolution (1024: light-space voxels per axis), light (index of the shadow light
 // among the scene's punctual lights; default the first directional or spot light),
 // pcf (1: k×k percentage-closer filtering), shadow_map_bits (32 or 16), tile (0: the
-// DAG build's x–y tile side, 0 = automatic), ambient (0.03: unshadowed ambient
+// DAG build's x–y tile side, 0 = automatic), undefined_as (lit: how undefined space
+// left inside boundary nodes is stored, lit or shadow), ambient (0.03: unshadowed ambient
 // irradiance as a fraction of the light's, so shadowed surfaces stay visible),
 // tile_size (16: image tile).
 // Layers: color (emission + diffuse reflection of the light and the ambient term),
@@ -34,6 +35,7 @@ struct DagShadowsSettings {
     int pcf = 1;
     int shadow_map_bits = 32;
     uint32_t tile = 0;
+    ShadowState undefined_as = ShadowState::Lit;
     float ambient = 0.03f;
     int tile_size = 16;
     static DagShadowsSettings from(const Settings& settings);
@@ -45,7 +47,7 @@ public:
     void prepare(const Scene& scene, const Settings& settings) override;
     void update(double time) override;
     void render(const ViewSet& views, std::vector<Film>& films) override;
-    Stats stats() const override { return stats_; }
+    Stats stats() const override;
 
     const ShadowDag* dag() const { return dag_.get(); }
     const ShadowMap* shadow_map() const { return map_.get(); }
@@ -61,6 +63,7 @@ private:
     std::unique_ptr<ShadowDag> dag_;
     std::unique_ptr<ShadowMap> map_;
     Stats stats_;
+    Stats structure_stats_;  // of the structure built last (replaced on every rebuild)
 };
 
 void register_dag_shadows(TechniqueRegistry& registry);
