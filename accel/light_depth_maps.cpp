@@ -75,8 +75,8 @@ void LightDepthTile::render(const RayTracer& tracer, const LightSpace& space, co
     const SceneFrame& frame = tracer.frame();
     std::vector<uint64_t> row_rays(size, 0);
     parallel_for(size, 1, [&](size_t begin, size_t end) {
-        std::vector<Ray> rays;
-        std::vector<Hit> hits;
+        std::vector<Ray> rays, exit_rays;
+        std::vector<Hit> hits, exit_hits;
         for (size_t row = begin; row < end; ++row) {
             const uint32_t y = y0 + uint32_t(row);
             if (y >= n) continue;
@@ -88,30 +88,58 @@ void LightDepthTile::render(const RayTracer& tracer, const LightSpace& space, co
             uint64_t cast = count;
             float* d1 = max_d1_[0].data() + row * size;
             float* d2 = min_d2_[0].data() + row * size;
+            // Texels that entered a closed part through its outside search for the exit,
+            // all of the row's continuation rays going out together as one stream.
+            struct Search {
+                uint32_t texel;
+                uint32_t mesh;
+                int32_t part;
+            };
+            std::vector<Search> searches;
             for (uint32_t i = 0; i < count; ++i) {
                 const Hit& h = hits[i];
                 if (!h.valid()) continue;
                 d1[i] = d2[i] = h.t;
                 if (!closed || closed->empty() || closed->component[h.mesh].empty()) continue;
                 const int32_t part = closed->component[h.mesh][h.triangle];
-                if (part < 0) continue;
-                // Entered through the outside? The face must face the light.
-                if (facing(frame, *closed, h, rays[i].direction) >= 0) continue;
-                Ray exit_ray = rays[i];
-                float t = h.t;
-                for (int step = 0; step < kMaxExitSteps; ++step) {
-                    exit_ray.tmin = t + std::max(1e-4f, t * 1e-6f);
-                    const Hit e = tracer.intersect(exit_ray);
-                    ++cast;
-                    if (!e.valid()) break;  // slipped out of the part unseen: leave the texel open
-                    t = e.t;
-                    if (e.mesh != h.mesh || closed->component[e.mesh][e.triangle] != part) continue;
+                if (part < 0 || facing(frame, *closed, h, rays[i].direction) >= 0) continue;
+                searches.push_back({i, h.mesh, part});
+                rays[i].tmin = h.t;
+            }
+            // The continuation rays keep their texel's place in a full-row stream (the rest
+            // inactive, tmin > tmax), so Embree groups them the same way whatever the
+            // tile: the answers then do not depend on how light space was tiled.
+            exit_rays.resize(count);
+            exit_hits.resize(count);
+            for (int step = 0; step < kMaxExitSteps && !searches.empty(); ++step) {
+                for (uint32_t i = 0; i < count; ++i) {
+                    exit_rays[i] = rays[i];
+                    exit_rays[i].tmin = 1.0f;
+                    exit_rays[i].tmax = 0.0f;
+                }
+                for (const Search& q : searches) {
+                    Ray& r = exit_rays[q.texel];
+                    r.tmin = rays[q.texel].tmin + std::max(1e-4f, rays[q.texel].tmin * 1e-6f);
+                    r.tmax = kInfinity;
+                }
+                tracer.intersect(exit_rays, exit_hits);
+                cast += searches.size();
+                size_t kept = 0;
+                for (size_t k = 0; k < searches.size(); ++k) {
+                    const Search& q = searches[k];
+                    const Hit& e = exit_hits[q.texel];
+                    if (!e.valid()) continue;  // slipped out of the part unseen: leave the texel open
+                    if (e.mesh != q.mesh || closed->component[e.mesh][e.triangle] != q.part) {
+                        rays[q.texel].tmin = e.t;  // another surface inside: look further
+                        searches[kept++] = q;
+                        continue;
+                    }
                     // The exit is a face of the same part turned away from the light; a
                     // face turned toward it means the real exit was missed (a ray through
                     // a shared edge): leave the texel open rather than guess.
-                    if (facing(frame, *closed, e, rays[i].direction) > 0) d2[i] = e.t;
-                    break;
+                    if (facing(frame, *closed, e, rays[q.texel].direction) > 0) d2[q.texel] = e.t;
                 }
+                searches.resize(kept);
             }
             row_rays[row] = cast;
         }

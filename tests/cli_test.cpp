@@ -241,3 +241,18 @@ TEST(Cli, ReportWithoutResultsIsAnError) {
     EXPECT_TRUE(contains(r.output, "no results")) << r.output;
     EXPECT_FALSE(fs::exists(dir / "report.html"));
 }
+
+TEST(Cli, RendersShadowsFromEveryStructure) {
+    const fs::path dir = gilab::test::temp_dir("cli_dag_shadows");
+    for (const std::string vis : {"ray", "shadow_map", "shadow_dag", "shadow_dag_double_depth"}) {
+        const fs::path out = dir / vis;
+        const Result r = run("render villa -t dag_shadows --set visibility=" + vis + " --set resolution=256 -W 64 -H 48 -o " +
+                             out.string());
+        EXPECT_EQ(r.exit_code, 0) << r.output;
+        EXPECT_TRUE(fs::exists(out.string() + ".exr")) << vis;
+        EXPECT_TRUE(fs::exists(out.string() + ".png")) << vis;
+    }
+    const fs::path bad = gilab::test::temp_dir("cli_dag_shadows_bad");
+    expect_failure("render fbm_terrain -t dag_shadows --set visibility=shadowmap -W 32 -H 32 -o " + (bad / "x").string(),
+                   {"dag_shadows.visibility", "shadowmap"}, bad);
+}

@@ -71,6 +71,11 @@ DagShadowsSettings DagShadowsSettings::from(const Settings& s) {
     o.ambient = s.get<float>("ambient", o.ambient);
     if (!(o.ambient >= 0 && o.ambient <= 1)) throw Error(std::string(kName) + ".ambient", "must be in [0, 1]");
     o.tile_size = s.get<int>("tile_size", o.tile_size);
+    // Nothing here is random; the seed every render passes is read so it is not an
+    // unknown setting, and recorded in the output.
+    const int64_t seed = s.get<int64_t>("seed", 1);
+    if (seed < 0) throw Error(std::string(kName) + ".seed", "must be non-negative");
+    o.seed = uint64_t(seed);
     if (o.tile_size < 1 || o.tile_size > 1024) throw Error(std::string(kName) + ".tile_size", "must be in 1..1024");
     return o;
 }
@@ -236,6 +241,7 @@ void DagShadowsTechnique::render(const ViewSet& views, std::vector<Film>& films)
         film.metadata["view"] = v < views.names.size() ? views.names[v] : "mono";
         film.metadata["visibility"] = to_string(settings_.visibility);
         film.metadata["resolution"] = std::to_string(settings_.resolution);
+        film.metadata["seed"] = std::to_string(settings_.seed);
         film.metadata["git_revision"] = GILAB_GIT_REVISION;
         films[v] = std::move(film);
     }

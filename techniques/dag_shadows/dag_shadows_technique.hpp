@@ -12,7 +12,7 @@
 // DAG build's x–y tile side, 0 = automatic), undefined_as (lit: how undefined space
 // left inside boundary nodes is stored, lit or shadow), ambient (0.03: unshadowed ambient
 // irradiance as a fraction of the light's, so shadowed surfaces stay visible),
-// tile_size (16: image tile).
+// tile_size (16: image tile), seed (recorded only: nothing is random).
 // Layers: color (emission + diffuse reflection of the light and the ambient term),
 // visibility (1 channel, the answer of the structure; 0 for background and for surfaces
 // turned away from the light, which are not looked up).
@@ -38,6 +38,7 @@ struct DagShadowsSettings {
     ShadowState undefined_as = ShadowState::Lit;
     float ambient = 0.03f;
     int tile_size = 16;
+    uint64_t seed = 1;  // accepted and recorded; the technique draws no random numbers
     static DagShadowsSettings from(const Settings& settings);
 };
 
