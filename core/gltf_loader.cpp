@@ -10,8 +10,10 @@
 //  * CUBICSPLINE animation samplers use each key's value and ignore the tangents (the
 //    curve is then interpolated linearly between keys).
 //  * When several animations drive the same property of a node, the first one wins.
-//  * Skinning and morph targets are not supported: a skinned mesh keeps its bind-pose
-//    geometry (placed where its joints put it in the rest pose) and a warning says so.
+//  * Skins (JOINTS_0/WEIGHTS_0, inverse bind matrices) are kept for linear blend skinning
+//    at evaluation time; the joints are ordinary nodes animated by the TRS channels.
+//    JOINTS_1/WEIGHTS_1 are ignored (four influences per vertex) with a warning.
+//  * Morph targets are not supported: the base shape is used and a warning says so.
 //  * Every accessor and index is range-checked: a bad file throws Error, never reads
 //    outside its buffers.
 #include <tiny_gltf.h>
@@ -23,6 +25,7 @@
 #include <sstream>
 #include "core/error.hpp"
 #include "core/mesh_loaders.hpp"
+#include "core/skin.hpp"
 
 namespace gilab {
 
@@ -166,6 +169,17 @@ std::vector<uint32_t> read_indices(const Context& ctx, int index, const std::str
     return out;
 }
 
+// JOINTS_0: unsigned byte or short, four per vertex (the specification allows no other).
+std::vector<uint16_t> read_joints(const Context& ctx, int index, const std::string& what) {
+    AccessorView v = view_accessor(ctx, index, what);
+    if (v.components != 4) throw Error(ctx.file, accessor_label(index, what) + ": joints must be VEC4");
+    if (v.normalized || (v.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+                         v.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT))
+        throw Error(ctx.file, accessor_label(index, what) + ": joints must be unnormalised unsigned byte or short");
+    const std::vector<float> f = read_floats(ctx, index, 4, what);
+    return std::vector<uint16_t>(f.begin(), f.end());  // exact: at most 65535
+}
+
 Mat4 node_local_matrix(const tinygltf::Node& n) {
     if (n.matrix.size() == 16) {
         Mat4 m;
@@ -289,6 +303,51 @@ struct MeshBuilder {
         return default_material;
     }
 
+    // Appends one primitive's joint influences, weights renormalised to sum to 1.
+    // Primitives without JOINTS_0 in a skinned mesh follow joint 0 rigidly.
+    void read_influences(const tinygltf::Primitive& prim, const std::string& where, size_t count, Mesh& mesh) {
+        auto j_it = prim.attributes.find("JOINTS_0");
+        auto w_it = prim.attributes.find("WEIGHTS_0");
+        const size_t before = mesh.positions.size() - count;  // this primitive's vertices were just appended
+        if (j_it == prim.attributes.end() && w_it == prim.attributes.end()) {
+            if (!mesh.influences.empty()) {
+                ctx.warn(where + ": no JOINTS_0 in a skinned mesh; its vertices follow joint 0");
+                mesh.influences.resize(mesh.positions.size(), VertexInfluences{{}, Vec4(1, 0, 0, 0)});
+            }
+            return;
+        }
+        if (j_it == prim.attributes.end() || w_it == prim.attributes.end())
+            throw Error(ctx.file, where + ": JOINTS_0 and WEIGHTS_0 must come together");
+        if (prim.attributes.count("JOINTS_1") || prim.attributes.count("WEIGHTS_1"))
+            ctx.warn(where + ": JOINTS_1/WEIGHTS_1 ignored; only four influences per vertex are used");
+        const std::vector<uint16_t> joints = read_joints(ctx, j_it->second, where + " JOINTS_0");
+        const std::vector<float> weights = read_floats(ctx, w_it->second, 4, where + " WEIGHTS_0");
+        if (joints.size() != 4 * count || weights.size() != 4 * count)
+            throw Error(ctx.file, where + ": " + std::to_string(joints.size() / 4) + " JOINTS_0 and " +
+                                      std::to_string(weights.size() / 4) + " WEIGHTS_0 elements for " +
+                                      std::to_string(count) + " vertices (count mismatch)");
+        if (mesh.influences.size() < before) {
+            if (before > 0) ctx.warn(where + ": earlier primitives have no JOINTS_0; their vertices follow joint 0");
+            mesh.influences.resize(before, VertexInfluences{{}, Vec4(1, 0, 0, 0)});
+        }
+        for (size_t i = 0; i < count; ++i) {
+            VertexInfluences in;
+            float sum = 0.0f;
+            for (int k = 0; k < 4; ++k) {
+                const float w = weights[4 * i + size_t(k)];
+                if (!std::isfinite(w) || w < 0.0f)
+                    throw Error(ctx.file, where + ": vertex " + std::to_string(i) + " has a negative or non-finite weight");
+                in.weights[k] = w;
+                in.joints[size_t(k)] = w > 0.0f ? joints[4 * i + size_t(k)] : 0;
+                sum += w;
+            }
+            if (!(sum > 0.0f))
+                throw Error(ctx.file, where + ": vertex " + std::to_string(i) + " has joint weights summing to zero");
+            in.weights /= sum;
+            mesh.influences.push_back(in);
+        }
+    }
+
     Mesh build(size_t mesh_index) {
         const tinygltf::Mesh& gm = ctx.model.meshes[mesh_index];
         Mesh mesh;
@@ -320,6 +379,7 @@ struct MeshBuilder {
             } else {
                 all_normals = false;
             }
+            read_influences(prim, where, count, mesh);
             auto uv_it = prim.attributes.find("TEXCOORD_0");
             if (uv_it != prim.attributes.end() && all_uvs) {
                 const std::vector<float> uv = read_floats(ctx, uv_it->second, 2, where + " TEXCOORD_0");
@@ -554,7 +614,6 @@ Scene load_gltf(const fs::path& path) {
     // Depth-first, so parents precede children; rest-pose world matrices on the way.
     std::vector<int> gltf_to_node(model.nodes.size(), -1);
     std::vector<Mat4> gltf_world(model.nodes.size(), Mat4(1.0f));
-    std::vector<bool> gltf_has_world(model.nodes.size(), false);
     std::function<void(int, int, const Mat4&)> visit = [&](int gi, int parent, const Mat4& parent_world) {
         if (gi < 0 || size_t(gi) >= model.nodes.size())
             throw Error(file, "node " + std::to_string(gi) + " is out of range (the file has " +
@@ -569,11 +628,47 @@ Scene load_gltf(const fs::path& path) {
         const int index = int(scene.nodes.size());
         gltf_to_node[size_t(gi)] = index;
         gltf_world[size_t(gi)] = parent_world * node_local_matrix(gn);
-        gltf_has_world[size_t(gi)] = true;
         scene.nodes.push_back(std::move(node));
         for (int child : gn.children) visit(child, index, gltf_world[size_t(gi)]);
     };
     for (int r : roots) visit(r, -1, Mat4(1.0f));
+
+    // Skins, converted once when a displayed node first uses them.
+    std::vector<int> skin_slots(model.skins.size(), -1);
+    auto skin_slot = [&](int gs) {
+        if (size_t(gs) >= model.skins.size())
+            throw Error(file, "skin " + std::to_string(gs) + " is out of range (the file has " +
+                                  std::to_string(model.skins.size()) + " skins)");
+        if (skin_slots[size_t(gs)] >= 0) return skin_slots[size_t(gs)];
+        const tinygltf::Skin& gskin = model.skins[size_t(gs)];
+        const std::string label = "skin " + std::to_string(gs) + (gskin.name.empty() ? "" : " '" + gskin.name + "'");
+        if (gskin.joints.empty()) throw Error(file, label + " has no joints");
+        Skin skin;
+        skin.name = gskin.name;
+        for (int j : gskin.joints) {
+            if (j < 0 || size_t(j) >= model.nodes.size() || gltf_to_node[size_t(j)] < 0)
+                throw Error(file, label + ": joint node " + std::to_string(j) +
+                                      " is out of range or not in the displayed scene");
+            skin.joints.push_back(uint32_t(gltf_to_node[size_t(j)]));
+        }
+        if (gskin.inverseBindMatrices >= 0) {
+            const std::vector<float> m16 = read_floats(ctx, gskin.inverseBindMatrices, 16, label + " inverse bind matrices");
+            if (m16.size() != 16 * skin.joints.size())
+                throw Error(file, label + ": " + std::to_string(m16.size() / 16) + " inverse bind matrices for " +
+                                      std::to_string(skin.joints.size()) + " joints (count mismatch)");
+            for (size_t k = 0; k < skin.joints.size(); ++k) {
+                Mat4 m;
+                for (int c = 0; c < 4; ++c)
+                    for (int r = 0; r < 4; ++r) m[c][r] = m16[16 * k + size_t(c * 4 + r)];
+                skin.inverse_bind.push_back(m);
+            }
+        } else {
+            skin.inverse_bind.assign(skin.joints.size(), Mat4(1.0f));  // the specification's default
+        }
+        scene.skins.push_back(std::move(skin));
+        skin_slots[size_t(gs)] = int(scene.skins.size() - 1);
+        return skin_slots[size_t(gs)];
+    };
 
     // Meshes (built once, shared by every node that instances them), lights, camera.
     std::vector<int> mesh_slot(model.meshes.size(), -1);
@@ -585,62 +680,27 @@ Scene load_gltf(const fs::path& path) {
             if (size_t(gn.mesh) >= model.meshes.size())
                 throw Error(file, "node " + std::to_string(gi) + " references mesh " + std::to_string(gn.mesh) +
                                       " but the file has " + std::to_string(model.meshes.size()) + " (out of range)");
-            if (gn.skin >= 0) {
-                if (size_t(gn.skin) >= model.skins.size())
-                    throw Error(file, "node " + std::to_string(gi) + " references skin " + std::to_string(gn.skin) +
-                                          " which is out of range");
-                // Bind pose: the skin's first joint in its rest pose times its inverse
-                // bind matrix places the geometry; the node's own transform is ignored.
-                const tinygltf::Skin& skin = model.skins[size_t(gn.skin)];
-                Mat4 place(1.0f);
-                if (!skin.joints.empty()) {
-                    const int j = skin.joints[0];
-                    if (j < 0 || size_t(j) >= model.nodes.size())
-                        throw Error(file, "skin " + std::to_string(gn.skin) + " joint " + std::to_string(j) +
-                                              " is out of range");
-                    Mat4 ibm(1.0f);
-                    if (skin.inverseBindMatrices >= 0) {
-                        std::vector<float> m16 = read_floats(ctx, skin.inverseBindMatrices, 16,
-                                                             "skin " + std::to_string(gn.skin) + " inverse bind matrices");
-                        if (m16.size() >= 16)
-                            for (int c = 0; c < 4; ++c)
-                                for (int r = 0; r < 4; ++r) ibm[c][r] = m16[size_t(c * 4 + r)];
-                    }
-                    place = (gltf_has_world[size_t(j)] ? gltf_world[size_t(j)] : Mat4(1.0f)) * ibm;
-                }
+            if (mesh_slot[size_t(gn.mesh)] < 0) {
                 Mesh mesh = builder.build(size_t(gn.mesh));
-                const Mat3 nm = glm::transpose(glm::inverse(Mat3(place)));
-                for (Vec3& p : mesh.positions) p = Vec3(place * Vec4(p, 1.0f));
-                for (Vec3& n : mesh.normals) {
-                    n = nm * n;
-                    float len = glm::length(n);
-                    n = len > 0 ? n / len : Vec3(0, 0, 1);
+                if (!mesh.triangles.empty()) {
+                    scene.degenerate_triangles_dropped +=
+                        validate_and_clean(mesh, scene.materials.size(), file).degenerate_triangles_dropped;
+                    scene.meshes.push_back(std::move(mesh));
+                    mesh_slot[size_t(gn.mesh)] = int(scene.meshes.size() - 1);
+                } else {
+                    mesh_slot[size_t(gn.mesh)] = INT32_MAX;  // nothing to draw
                 }
-                if (glm::determinant(Mat3(place)) < 0)
-                    for (UVec3& t : mesh.triangles) std::swap(t.y, t.z);
-                ctx.warn("mesh '" + mesh.name + "' is skinned; skinning is not supported, the bind-pose geometry is used");
-                if (mesh.triangles.empty()) continue;
-                scene.degenerate_triangles_dropped +=
-                    validate_and_clean(mesh, scene.materials.size(), file).degenerate_triangles_dropped;
-                SceneNode holder;
-                holder.name = scene.nodes[size_t(ni)].name + " (bind pose)";
-                scene.meshes.push_back(std::move(mesh));
-                holder.meshes.push_back(uint32_t(scene.meshes.size() - 1));
-                scene.nodes.push_back(std::move(holder));
-            } else {
-                if (mesh_slot[size_t(gn.mesh)] < 0) {
-                    Mesh mesh = builder.build(size_t(gn.mesh));
-                    if (!mesh.triangles.empty()) {
-                        scene.degenerate_triangles_dropped +=
-                            validate_and_clean(mesh, scene.materials.size(), file).degenerate_triangles_dropped;
-                        scene.meshes.push_back(std::move(mesh));
-                        mesh_slot[size_t(gn.mesh)] = int(scene.meshes.size() - 1);
-                    } else {
-                        mesh_slot[size_t(gn.mesh)] = INT32_MAX;  // nothing to draw
-                    }
+            }
+            const int slot = mesh_slot[size_t(gn.mesh)];
+            if (slot != INT32_MAX) {
+                scene.nodes[size_t(ni)].meshes.push_back(uint32_t(slot));
+                if (gn.skin >= 0) {
+                    if (scene.meshes[size_t(slot)].influences.empty())
+                        throw Error(file, "node " + std::to_string(gi) + " has skin " + std::to_string(gn.skin) +
+                                              " but mesh '" + scene.meshes[size_t(slot)].name +
+                                              "' has no JOINTS_0/WEIGHTS_0");
+                    scene.nodes[size_t(ni)].skin = skin_slot(gn.skin);
                 }
-                if (mesh_slot[size_t(gn.mesh)] != INT32_MAX)
-                    scene.nodes[size_t(ni)].meshes.push_back(uint32_t(mesh_slot[size_t(gn.mesh)]));
             }
         }
         auto light_ext = gn.extensions.find("KHR_lights_punctual");
@@ -687,6 +747,9 @@ Scene load_gltf(const fs::path& path) {
     }
     load_animations(ctx, gltf_to_node);
     if (scene.meshes.empty()) throw Error(file, "no triangle meshes in the displayed scene");
+    for (const SceneNode& node : scene.nodes)
+        if (node.skin >= 0)
+            for (uint32_t m : node.meshes) check_influences(scene.meshes[m], scene.skins[size_t(node.skin)].joints.size(), file);
     return scene;
 }
 

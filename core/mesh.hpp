@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 #include "core/math.hpp"
+#include "core/skin.hpp"
 
 namespace gilab {
 
@@ -14,6 +15,7 @@ struct Mesh {
     std::vector<Vec2> uvs;            // per vertex, optional
     std::vector<UVec3> triangles;     // vertex indices
     std::vector<uint32_t> material_ids;  // one per triangle, index into Scene::materials
+    std::vector<VertexInfluences> influences;  // per vertex, for skinning (empty = rigid)
 
     size_t triangle_count() const { return triangles.size(); }
     Bounds3 bounds() const;

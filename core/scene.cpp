@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include "core/error.hpp"
+#include "core/skin.hpp"
 
 namespace gilab {
 
@@ -65,41 +66,67 @@ std::vector<Mat4> Scene::node_transforms(double time) const {
     return world;
 }
 
-SceneFrame Scene::evaluate(double time) const {
+std::vector<Mat4> Scene::rest_node_transforms() const {
+    std::vector<Mat4> world(nodes.size());
+    for (size_t i = 0; i < nodes.size(); ++i) {
+        const Mat4 m = nodes[i].local.matrix();
+        world[i] = nodes[i].parent >= 0 ? world[size_t(nodes[i].parent)] * m : m;
+    }
+    return world;
+}
+
+namespace {
+
+void place_rigid(const Mesh& mesh, const Mat4& m, WorldMesh& wm) {
+    // Normals transform by the inverse transpose; a mirroring transform flips the
+    // winding, which we undo so the geometric normal keeps pointing outwards.
+    const Mat3 normal_matrix = glm::transpose(glm::inverse(Mat3(m)));
+    wm.positions.reserve(mesh.positions.size());
+    for (const Vec3& p : mesh.positions) wm.positions.push_back(Vec3(m * Vec4(p, 1.0f)));
+    wm.normals.reserve(mesh.normals.size());
+    for (const Vec3& n : mesh.normals) {
+        Vec3 t = normal_matrix * n;
+        float len = glm::length(t);
+        wm.normals.push_back(len > 0 ? t / len : Vec3(0, 0, 1));
+    }
+    wm.triangles = mesh.triangles;
+    if (glm::determinant(Mat3(m)) < 0)
+        for (UVec3& t : wm.triangles) std::swap(t.y, t.z);
+}
+
+void place_skinned(const Mesh& mesh, std::span<const Mat4> joints, WorldMesh& wm) {
+    skin_vertices(mesh, joints, wm.positions, wm.normals);
+    wm.triangles = mesh.triangles;
+    // Winding follows the first joint: a blend cannot flip it per triangle.
+    if (!joints.empty() && glm::determinant(Mat3(joints[0])) < 0)
+        for (UVec3& t : wm.triangles) std::swap(t.y, t.z);
+}
+
+SceneFrame flatten(const Scene& scene, const std::vector<Mat4>& world, double time) {
     SceneFrame frame;
     frame.time = time;
-    std::vector<Mat4> world = node_transforms(time);
-    for (size_t i = 0; i < nodes.size(); ++i) {
-        const Mat4& m = world[i];
-        // Normals transform by the inverse transpose; a mirroring transform flips the
-        // winding, which we undo so the geometric normal keeps pointing outwards.
-        Mat3 normal_matrix = glm::transpose(glm::inverse(Mat3(m)));
-        bool mirrored = glm::determinant(Mat3(m)) < 0;
-        for (uint32_t mesh_index : nodes[i].meshes) {
-            const Mesh& mesh = meshes[mesh_index];
+    std::vector<std::vector<Mat4>> joints(scene.skins.size());  // per skin, computed on first use
+    for (size_t i = 0; i < scene.nodes.size(); ++i) {
+        const SceneNode& node = scene.nodes[i];
+        const bool skinned = node.skin >= 0;
+        if (skinned && size_t(node.skin) >= scene.skins.size())
+            throw Error(scene.source.empty() ? scene.name : scene.source,
+                        "node " + std::to_string(i) + " references skin " + std::to_string(node.skin) + " (out of range)");
+        if (skinned && joints[size_t(node.skin)].empty())
+            joints[size_t(node.skin)] = joint_matrices(scene.skins[size_t(node.skin)], world);
+        for (uint32_t mesh_index : node.meshes) {
+            const Mesh& mesh = scene.meshes[mesh_index];
             WorldMesh wm;
             wm.source_mesh = mesh_index;
             wm.node = uint32_t(i);
-            wm.positions.reserve(mesh.positions.size());
-            for (const Vec3& p : mesh.positions) {
-                Vec3 q = Vec3(m * Vec4(p, 1.0f));
-                wm.positions.push_back(q);
-                frame.bounds.extend(q);
-            }
-            wm.normals.reserve(mesh.normals.size());
-            for (const Vec3& n : mesh.normals) {
-                Vec3 t = normal_matrix * n;
-                float len = glm::length(t);
-                wm.normals.push_back(len > 0 ? t / len : Vec3(0, 0, 1));
-            }
-            wm.triangles = mesh.triangles;
-            if (mirrored)
-                for (UVec3& t : wm.triangles) std::swap(t.y, t.z);
+            if (skinned && !mesh.influences.empty()) place_skinned(mesh, joints[size_t(node.skin)], wm);
+            else place_rigid(mesh, world[i], wm);
+            for (const Vec3& q : wm.positions) frame.bounds.extend(q);
             wm.material_ids = mesh.material_ids;
             frame.meshes.push_back(std::move(wm));
         }
     }
-    for (const PunctualLight& light : lights) {
+    for (const PunctualLight& light : scene.lights) {
         PunctualLight l = light;
         if (light.node >= 0 && size_t(light.node) < world.size()) {
             const Mat4& m = world[size_t(light.node)];
@@ -112,6 +139,12 @@ SceneFrame Scene::evaluate(double time) const {
     return frame;
 }
 
+}  // namespace
+
+SceneFrame Scene::evaluate(double time) const { return flatten(*this, node_transforms(time), time); }
+
+SceneFrame Scene::evaluate_rest() const { return flatten(*this, rest_node_transforms(), 0.0); }
+
 void Scene::validate() const {
     const std::string where = source.empty() ? name : source;
     if (meshes.empty() || triangle_count() == 0) throw Error(where, "scene has no triangles (empty scene)");
@@ -123,6 +156,28 @@ void Scene::validate() const {
             if (m >= meshes.size())
                 throw Error(where, "node " + std::to_string(i) + " references mesh " + std::to_string(m) +
                                        " but the scene has " + std::to_string(meshes.size()));
+        if (n.skin < 0) continue;
+        if (size_t(n.skin) >= skins.size())
+            throw Error(where, "node " + std::to_string(i) + " ('" + n.name + "') references skin " +
+                                   std::to_string(n.skin) + " but the scene has " + std::to_string(skins.size()));
+        for (uint32_t m : n.meshes) {
+            if (meshes[m].influences.empty())
+                throw Error(where, "node " + std::to_string(i) + " ('" + n.name + "') is skinned but mesh '" +
+                                       meshes[m].name + "' has no joint influences");
+            check_influences(meshes[m], skins[size_t(n.skin)].joints.size(), where);
+        }
+    }
+    for (size_t k = 0; k < skins.size(); ++k) {
+        const Skin& skin = skins[k];
+        const std::string label = "skin " + std::to_string(k) + (skin.name.empty() ? "" : " ('" + skin.name + "')");
+        if (skin.joints.empty()) throw Error(where, label + " has no joints");
+        if (skin.inverse_bind.size() != skin.joints.size())
+            throw Error(where, label + " has " + std::to_string(skin.inverse_bind.size()) + " inverse bind matrices for " +
+                                   std::to_string(skin.joints.size()) + " joints (count mismatch)");
+        for (uint32_t j : skin.joints)
+            if (j >= nodes.size())
+                throw Error(where, label + " uses node " + std::to_string(j) + " as a joint but the scene has " +
+                                       std::to_string(nodes.size()) + " nodes (joint index out of range)");
     }
     for (size_t i = 0; i < meshes.size(); ++i) {
         const Mesh& mesh = meshes[i];

@@ -20,6 +20,7 @@ struct SceneNode {
     Transform local;                 // rest pose
     TrsAnimation animation;          // empty = static
     std::vector<uint32_t> meshes;    // indices into Scene::meshes
+    int skin = -1;                   // index into Scene::skins: its meshes are posed by their joints
 };
 
 struct SceneCamera {
@@ -59,6 +60,7 @@ struct Scene {
     std::vector<Material> materials;
     std::vector<Mesh> meshes;
     std::vector<SceneNode> nodes;    // parents come before children
+    std::vector<Skin> skins;         // joints are node indices
     std::vector<PunctualLight> lights;  // in the space of their node (world if node = -1)
     std::optional<SceneCamera> camera;
     std::optional<SceneHmd> hmd;
@@ -75,14 +77,20 @@ struct Scene {
     size_t triangle_count() const;         // over all instances
     bool has_emitters() const;             // any emissive triangle or punctual light
 
-    // World-space geometry and lights at time t (seconds) / at frame k.
+    // World-space geometry and lights at time t (seconds) / at frame k. A skinned node's
+    // meshes follow its joints by linear blend skinning; the node's own transform is
+    // ignored, as glTF specifies.
     SceneFrame evaluate(double time) const;
     SceneFrame evaluate_frame(int frame) const { return evaluate(frame / frames_per_second); }
-    // World transform of every node at time t.
+    // Every node at its rest transform, animation ignored. For glTF skins this is
+    // normally the bind pose, which their animations need not pass through.
+    SceneFrame evaluate_rest() const;
+    // World transform of every node at time t / at rest.
     std::vector<Mat4> node_transforms(double time) const;
+    std::vector<Mat4> rest_node_transforms() const;
 
     // Throws Error naming `source` if the scene cannot be rendered: no geometry,
-    // dangling mesh/material/parent indices.
+    // dangling mesh/material/parent/skin/joint indices, unusable joint influences.
     void validate() const;
 };
 

@@ -10,6 +10,7 @@
 #include <sstream>
 #include "core/error.hpp"
 #include "core/mesh_loaders.hpp"
+#include "core/skin.hpp"
 
 namespace gilab {
 
@@ -183,10 +184,16 @@ struct SceneBuilder {
             scene.meshes.push_back(std::move(mesh));
         }
         const int node_offset = int(scene.nodes.size());
+        const int skin_offset = int(scene.skins.size());
         for (SceneNode node : sub.nodes) {
             node.parent = node.parent >= 0 ? node.parent + node_offset : int(parent);
             for (uint32_t& m : node.meshes) m += mesh_offset;
+            if (node.skin >= 0) node.skin += skin_offset;
             scene.nodes.push_back(std::move(node));
+        }
+        for (Skin skin : sub.skins) {
+            for (uint32_t& j : skin.joints) j += uint32_t(node_offset);
+            scene.skins.push_back(std::move(skin));
         }
         for (PunctualLight light : sub.lights) {
             light.node = light.node >= 0 ? light.node + node_offset : int(parent);
@@ -212,16 +219,28 @@ struct SceneBuilder {
     }
 
     // Bounds of the subtree rooted at `root` (every node after it belongs to it), with
-    // the root's local transform replaced by `root_local`.
+    // the root's local transform replaced by `root_local`. Skinned meshes are measured in
+    // their rest (bind) pose, placed by their joints as evaluate() places them.
     Bounds3 subtree_bounds(uint32_t root, const Transform& root_local) const {
         std::vector<Mat4> world(scene.nodes.size(), Mat4(1.0f));
-        Bounds3 b;
         for (size_t i = root; i < scene.nodes.size(); ++i) {
             const SceneNode& n = scene.nodes[i];
             const Mat4 local = i == root ? root_local.matrix() : n.local.matrix();
             world[i] = (i == root || n.parent < 0) ? local : world[size_t(n.parent)] * local;
-            for (uint32_t m : n.meshes)
-                for (const Vec3& p : scene.meshes[m].positions) b.extend(Vec3(world[i] * Vec4(p, 1.0f)));
+        }
+        Bounds3 b;
+        std::vector<Vec3> posed, normals;
+        for (size_t i = root; i < scene.nodes.size(); ++i) {
+            const SceneNode& n = scene.nodes[i];
+            for (uint32_t m : n.meshes) {
+                const Mesh& mesh = scene.meshes[m];
+                if (n.skin >= 0 && !mesh.influences.empty()) {
+                    skin_vertices(mesh, joint_matrices(scene.skins[size_t(n.skin)], world), posed, normals);
+                    for (const Vec3& p : posed) b.extend(p);
+                } else {
+                    for (const Vec3& p : mesh.positions) b.extend(Vec3(world[i] * Vec4(p, 1.0f)));
+                }
+            }
         }
         return b;
     }

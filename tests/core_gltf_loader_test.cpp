@@ -1,6 +1,7 @@
 // glTF loading: files written by tinygltf's own writer (.gltf with an embedded base64
-// buffer, and .glb) round-trip through load_gltf; malformed files fail with the file
-// name; the animated sample models from ../shared/scenes match the MANIFEST.
+// buffer, and .glb) round-trip through load_gltf; malformed files and bad skins fail
+// with the file name; a skinned mesh at its bind-pose time equals the unskinned mesh;
+// the animated sample models from ../shared/scenes match the MANIFEST.
 #include <gtest/gtest.h>
 #include <tiny_gltf.h>
 
@@ -8,6 +9,7 @@
 #include <fstream>
 #include "core/error.hpp"
 #include "core/mesh_loaders.hpp"
+#include "core/scene_file.hpp"
 #include "tests/test_support.hpp"
 
 namespace fs = std::filesystem;
@@ -306,27 +308,141 @@ TEST(GltfLoader, MeshFileDispatch) {
     EXPECT_EQ(load_mesh_file(b.write(dir / "x.GLB", true)).meshes.size(), 2u);
 }
 
-TEST(GltfLoader, SkinnedMeshLoadsBindPoseWithWarning) {
+// A strip of three vertex rows (y = 0, 1, 2) skinned to two joints: the bottom row to
+// the root joint, the middle row half and half, the top row to the tip joint. The tip
+// turns 90° about z between t = 0 (its rest rotation) and t = 1. Without `skinned` the
+// same mesh is a plain mesh at the origin.
+struct SkinFixture {
+    std::vector<uint16_t> joints = {0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    std::vector<float> weights = {1, 0, 0, 0, 1, 0, 0, 0, 0.5f, 0.5f, 0, 0, 0.5f, 0.5f, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    size_t inverse_binds = 2;
+
+    ModelBuilder build(bool skinned) const {
+        ModelBuilder b;
+        const std::vector<float> pos = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 2, 0, 1, 2, 0};
+        std::vector<float> nrm;
+        for (int i = 0; i < 6; ++i) nrm.insert(nrm.end(), {0, 0, 1});
+        const int mesh = b.add_triangle_mesh(pos, {0, 1, 3, 0, 3, 2, 2, 3, 5, 2, 5, 4}, -1, nrm);
+        const int body = b.add_node("body", mesh);
+        if (!skinned) {
+            b.finish({body});
+            return b;
+        }
+        auto& prim = b.model.meshes[size_t(mesh)].primitives[0];
+        prim.attributes["JOINTS_0"] = b.add_accessor(joints.data(), joints.size() * 2, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+                                                     TINYGLTF_TYPE_VEC4, joints.size() / 4);
+        prim.attributes["WEIGHTS_0"] = b.floats(weights, TINYGLTF_TYPE_VEC4, 4);
+        const int root = b.add_node("root_joint");
+        b.model.nodes[size_t(root)].translation = {0, 0, 4};
+        const int tip = b.add_node("tip_joint");
+        b.model.nodes[size_t(tip)].translation = {0, 1, 0};
+        b.model.nodes[size_t(root)].children = {tip};
+        b.model.nodes[size_t(body)].translation = {100, 100, 100};  // ignored for skinned meshes
+        b.model.nodes[size_t(body)].scale = {3, 3, 3};
+        b.model.nodes[size_t(body)].skin = 0;
+        // Inverse bind matrices: the inverse of each joint's rest world matrix, column-major.
+        const std::vector<float> ibm = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, -4, 1,
+                                        1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, -4, 1};
+        tinygltf::Skin skin;
+        skin.name = "strip";
+        skin.joints = {root, tip};
+        skin.inverseBindMatrices = b.floats(std::vector<float>(ibm.begin(), ibm.begin() + long(16 * inverse_binds)),
+                                            TINYGLTF_TYPE_MAT4, 16);
+        b.model.skins.push_back(skin);
+        const float h = std::sqrt(0.5f);
+        tinygltf::Animation anim;
+        tinygltf::AnimationSampler sm;
+        sm.input = b.floats({0.0f, 1.0f}, TINYGLTF_TYPE_SCALAR, 1);
+        sm.output = b.floats({0, 0, 0, 1, 0, 0, h, h}, TINYGLTF_TYPE_VEC4, 4);  // xyzw
+        anim.samplers.push_back(sm);
+        tinygltf::AnimationChannel ch;
+        ch.sampler = 0;
+        ch.target_node = tip;
+        ch.target_path = "rotation";
+        anim.channels.push_back(ch);
+        b.model.animations.push_back(anim);
+        b.finish({root, body});
+        return b;
+    }
+};
+
+TEST(GltfLoader, SkinnedMeshAtBindPoseTimeEqualsTheUnskinnedMesh) {
     auto dir = test::temp_dir("gltf_skin");
+    const SkinFixture fx;
+    const Scene skinned = load_gltf(fx.build(true).write(dir / "skin.gltf", false));
+    const Scene plain = load_gltf(fx.build(false).write(dir / "plain.glb", true));
+    for (const auto& w : skinned.warnings) EXPECT_EQ(w.find("skin"), std::string::npos) << w;
+    ASSERT_EQ(skinned.skins.size(), 1u);
+    EXPECT_EQ(skinned.skins[0].joints.size(), 2u);
+    EXPECT_NO_THROW(skinned.validate());
+    const SceneFrame a = skinned.evaluate(0.0), b = plain.evaluate(0.0);
+    ASSERT_EQ(a.meshes.size(), 1u);
+    ASSERT_EQ(b.meshes.size(), 1u);
+    EXPECT_EQ(a.meshes[0].triangles, b.meshes[0].triangles);
+    for (size_t v = 0; v < b.meshes[0].positions.size(); ++v) {
+        EXPECT_NEAR(glm::length(a.meshes[0].positions[v] - b.meshes[0].positions[v]), 0.0f, 1e-6f) << "vertex " << v;
+        EXPECT_NEAR(glm::length(a.meshes[0].normals[v] - b.meshes[0].normals[v]), 0.0f, 1e-6f) << "vertex " << v;
+    }
+    // At t = 1 the tip turns 90° about z through its joint at (0, 1, 0) in mesh space; the
+    // bottom row stays, the middle row is the mean of staying and turning.
+    const std::vector<Vec3> expected = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.5f, 1.5f, 0}, {-1, 1, 0}, {-1, 2, 0}};
+    const SceneFrame turned = skinned.evaluate(1.0);
+    for (size_t v = 0; v < expected.size(); ++v)
+        EXPECT_NEAR(glm::length(turned.meshes[0].positions[v] - expected[v]), 0.0f, 1e-5f) << "vertex " << v;
+}
+
+// A scene file fits a skinned model by its bind pose as skinning places it, not by the
+// skinned node's own (ignored) transform.
+TEST(GltfLoader, SceneFileFitsASkinnedModelInItsBindPose) {
+    auto dir = test::temp_dir("gltf_skin_fit");
+    SkinFixture().build(true).write(dir / "strip.glb", true);
+    const fs::path json = write_file(dir, "fit.json", R"({
+  "meshes": [{"file": "strip.glb", "fit_to_box": {"min": [0, 0, 0], "max": [1, 1, 1], "anchor": "bottom"}}],
+  "lights": [{"type": "point", "position": [0, 5, 0], "intensity": 1}]
+})");
+    const Scene s = load_scene_file(json, AssetPaths{});
+    const Bounds3 b = s.evaluate_rest().bounds;  // 1 × 2 × 0 in mesh space: scaled by 1/2
+    EXPECT_NEAR(b.min.y, 0.0f, 1e-5f);
+    EXPECT_NEAR(b.max.y, 1.0f, 1e-5f);
+    EXPECT_NEAR(b.extent().x, 0.5f, 1e-5f);
+    EXPECT_NEAR(b.center().x, 0.5f, 1e-5f);
+}
+
+TEST(GltfLoader, BadSkinsAreErrorsNamingTheFile) {
+    auto dir = test::temp_dir("gltf_bad_skin");
+    struct Case {
+        const char* file;
+        std::function<void(SkinFixture&)> spoil;
+        const char* message;
+    };
+    const std::vector<Case> cases = {
+        {"joint.gltf", [](SkinFixture& f) { f.joints[16] = 5; }, "joint index out of range"},
+        {"weights.gltf", [](SkinFixture& f) { f.weights.resize(20); }, "count mismatch"},
+        {"zero.gltf", [](SkinFixture& f) { std::fill(f.weights.begin() + 8, f.weights.begin() + 12, 0.0f); },
+         "summing to zero"},
+        {"negative.gltf", [](SkinFixture& f) { f.weights[1] = -0.5f; }, "negative"},
+        {"ibm.gltf", [](SkinFixture& f) { f.inverse_binds = 1; }, "count mismatch"},
+    };
+    for (const Case& c : cases) {
+        SkinFixture fx;
+        c.spoil(fx);
+        const fs::path path = fx.build(true).write(dir / c.file, false);
+        const std::string msg = error_of([&] { load_gltf(path); });
+        EXPECT_NE(msg.find(c.file), std::string::npos) << msg;
+        EXPECT_NE(msg.find(c.message), std::string::npos) << msg;
+    }
+}
+
+TEST(GltfLoader, MorphTargetsStayUnsupportedWithWarning) {
+    auto dir = test::temp_dir("gltf_morph");
     ModelBuilder b;
-    const int mesh = b.add_triangle_mesh({0, 0, 0, 1, 0, 0, 0, 1, 0}, {0, 1, 2}, -1);
-    const int joint = b.add_node("joint");
-    b.model.nodes[size_t(joint)].translation = {0, 0, 4};
-    const int skinned = b.add_node("body", mesh);
-    b.model.nodes[size_t(skinned)].translation = {100, 100, 100};  // ignored for skinned meshes
-    b.model.nodes[size_t(skinned)].skin = 0;
-    tinygltf::Skin skin;
-    skin.joints = {joint};
-    b.model.skins.push_back(skin);
-    b.finish({joint, skinned});
-    Scene s = load_gltf(b.write(dir / "skin.gltf", false));
+    b.add_triangle_mesh(kQuad, kQuadIndices, -1);
+    b.model.meshes[0].primitives[0].targets.push_back({{"POSITION", b.vec3s(kQuad)}});
+    b.finish({b.add_node("n", 0)});
+    Scene s = load_gltf(b.write(dir / "morph.gltf", false));
     bool warned = false;
-    for (const auto& w : s.warnings) warned |= w.find("skinning is not supported") != std::string::npos;
+    for (const auto& w : s.warnings) warned |= w.find("morph targets are not supported") != std::string::npos;
     EXPECT_TRUE(warned);
-    SceneFrame f = s.evaluate(0.0);
-    ASSERT_EQ(f.meshes.size(), 1u);
-    EXPECT_NEAR(f.meshes[0].positions[1].x, 1.0f, 1e-6f);
-    EXPECT_NEAR(f.meshes[0].positions[1].z, 4.0f, 1e-6f);
 }
 
 TEST(GltfLoader, MissingFile) {
@@ -455,9 +571,14 @@ TEST_P(RealGlb, MatchesManifestAndIsAnimated) {
     EXPECT_EQ(triangles + s.degenerate_triangles_dropped, a.triangles);
     EXPECT_TRUE(s.is_animated());
     EXPECT_GT(s.animation_duration(), 0.0);
-    bool warned = false;
-    for (const auto& w : s.warnings) warned |= w.find("skinning is not supported") != std::string::npos;
-    EXPECT_TRUE(warned);
+    // Skinned, with one influence per vertex of every skinned mesh.
+    EXPECT_FALSE(s.skins.empty());
+    for (const auto& node : s.nodes)
+        for (uint32_t m : node.meshes)
+            if (node.skin >= 0) {
+                EXPECT_EQ(s.meshes[m].influences.size(), s.meshes[m].positions.size());
+            }
+    for (const auto& w : s.warnings) EXPECT_EQ(w.find("skin"), std::string::npos) << w;
     EXPECT_NO_THROW(s.validate());
 }
 

@@ -1,10 +1,11 @@
 // Scene description files: placement, material overrides and merging, lights, camera,
-// HMD, animation; every error names the file and the JSON path; every shipped scene
-// in scenes/ loads.
+// HMD, animation, skinned files merged and fitted; every error names the file and the
+// JSON path; every shipped scene in scenes/ loads.
 #include <gtest/gtest.h>
 
 #include <fstream>
 #include "core/error.hpp"
+#include "core/mesh_loaders.hpp"
 #include "core/scene_file.hpp"
 #include "tests/test_support.hpp"
 
@@ -323,6 +324,71 @@ TEST(ShippedScenes, KitchenMergesAllPartsWithManifestCounts) {
     std::map<std::string, int> names;
     for (const auto& m : s.materials) ++names[m.name];
     for (const auto& [name, n] : names) EXPECT_LE(n, 2) << name;
+}
+
+// The five animated samples move by their own skinned animation, not a turntable, and
+// their bind pose as skinning places it fills their fit box.
+TEST(ShippedScenes, SkinnedModelsUseTheirOwnAnimationAndFitTheirBox) {
+    struct Model {
+        const char* scene;
+        const char* asset;
+        Vec3 box_min, box_max;
+    };
+    const Model models[] = {{"brainstem", "animated/BrainStem.glb", {-1.2f, 0, -1.2f}, {1.2f, 1.8f, 1.2f}},
+                            {"cesium_man", "animated/CesiumMan.glb", {}, {}},
+                            {"fox", "animated/Fox.glb", {}, {}},
+                            {"rigged_figure", "animated/RiggedFigure.glb", {}, {}},
+                            {"rigged_simple", "animated/RiggedSimple.glb", {-0.4f, 0, -0.4f}, {0.4f, 1.8f, 0.4f}}};
+    for (const Model& m : models) {
+        SCOPED_TRACE(m.scene);
+        if (!test::shared_asset(m.asset)) GTEST_SKIP() << m.asset << " not found";
+        const Scene s = load_scene_file(fs::path(GILAB_SOURCE_DIR) / "scenes" / (std::string(m.scene) + ".json"),
+                                        AssetPaths::from_environment());
+        const Scene file = load_gltf(*test::shared_asset(m.asset));
+        EXPECT_FALSE(s.skins.empty());
+        for (const SceneNode& n : s.nodes)
+            if (n.name == "model") {
+                EXPECT_TRUE(n.animation.empty()) << "the entry must not carry a turntable";
+            }
+        EXPECT_DOUBLE_EQ(s.animation_duration(), file.animation_duration());
+        if (m.box_max == m.box_min) continue;
+        Bounds3 b;  // the model alone, at rest
+        const SceneFrame rest = s.evaluate_rest();
+        for (const WorldMesh& wm : rest.meshes)
+            if (s.nodes[wm.node].skin >= 0)
+                for (const Vec3& p : wm.positions) b.extend(p);
+        const Vec3 target = m.box_max - m.box_min;
+        EXPECT_NEAR(b.min.y, m.box_min.y, 1e-4f);  // anchor "bottom"
+        float fill = 0;
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_LE(b.extent()[c], target[c] + 1e-4f) << "axis " << c;
+            fill = std::max(fill, b.extent()[c] / target[c]);
+        }
+        EXPECT_NEAR(fill, 1.0f, 1e-4f) << "the fitted model touches its box on one axis";
+    }
+}
+
+// A skinned file used by two entries loads once and is merged twice: each copy's skin
+// must point at its own joints, so the second copy is the first one moved.
+TEST(SceneFile, SkinnedFileMergedTwiceKeepsItsOwnJoints) {
+    auto asset = test::shared_asset("animated/RiggedSimple.glb");
+    if (!asset) GTEST_SKIP() << "animated/RiggedSimple.glb not found";
+    auto dir = test::temp_dir("scene_two_skins");
+    const fs::path path = write_file(dir, "two.json", R"({
+  "meshes": [
+    {"name": "a", "file": ")" + asset->string() + R"("},
+    {"name": "b", "file": ")" + asset->string() + R"(", "translate": [5, 0, 0]}
+  ],
+  "lights": [{"type": "point", "position": [0, 5, 0], "intensity": 1}]
+})");
+    const Scene s = load(path);
+    ASSERT_EQ(s.skins.size(), 2u);
+    EXPECT_NO_THROW(s.validate());
+    for (uint32_t j : s.skins[0].joints) EXPECT_LT(j, s.skins[1].joints.front());
+    const SceneFrame f = s.evaluate(1.0);
+    ASSERT_EQ(f.meshes.size(), 2u);
+    for (size_t v = 0; v < f.meshes[0].positions.size(); ++v)
+        EXPECT_NEAR(glm::length(f.meshes[1].positions[v] - (f.meshes[0].positions[v] + Vec3(5, 0, 0))), 0.0f, 1e-4f);
 }
 
 TEST(AssetPathsTest, SearchOrderFlagThenEnvironmentThenSharedScenes) {

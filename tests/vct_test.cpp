@@ -11,6 +11,7 @@
 #include "core/error.hpp"
 #include "core/image_metrics.hpp"
 #include "core/parallel.hpp"
+#include "core/skin.hpp"
 #include "scenes/builtin_scenes.hpp"
 #include "techniques/technique.hpp"
 #include "techniques/vct/cone_tracer.hpp"
@@ -394,6 +395,33 @@ TEST(VctTechnique, SpecularConeReflectsTheScene) {
     EXPECT_TRUE(on->stats().has("specular_ms"));
     // The diffuse part does not depend on the specular cone.
     EXPECT_LT(max_abs_difference(a, b, "indirect"), 1e-6);
+}
+
+TEST(VctTechnique, SkinnedMeshesMovingWithTheirJointsAreNotVoxelized) {
+    // A quad bound to a joint node that is animated elsewhere in the hierarchy: its own
+    // node has no keys, yet it moves, so it must be left out like any dynamic mesh.
+    Scene scene = make_cornell_box();
+    Mesh quad;
+    quad.name = "skinned";
+    quad.positions = {Vec3(0.45f, 0.5f, 0.45f), Vec3(0.55f, 0.5f, 0.45f), Vec3(0.55f, 0.5f, 0.55f), Vec3(0.45f, 0.5f, 0.55f)};
+    quad.triangles = {{0, 1, 2}, {0, 2, 3}};
+    quad.material_ids = {0, 0};
+    VertexInfluences follow_joint;
+    follow_joint.weights = Vec4(1, 0, 0, 0);
+    quad.influences.assign(4, follow_joint);
+    const uint32_t mesh_node = scene.add_mesh_instance(quad);
+    SceneNode joint;
+    joint.name = "joint";
+    joint.animation.translation.times = {0.0f, 1.0f};
+    joint.animation.translation.values = {Vec3(0), Vec3(0, 0.1f, 0)};
+    scene.nodes.push_back(joint);
+    Skin skin;
+    skin.joints = {uint32_t(scene.nodes.size() - 1)};
+    skin.inverse_bind = {Mat4(1.0f)};
+    scene.skins.push_back(skin);
+    scene.nodes[mesh_node].skin = 0;
+    auto with = prepared(scene, {{"dense_resolution", 64}, {"diffuse", false}});
+    EXPECT_EQ(with->stats().get("voxelized_triangles") + 2, with->stats().get("triangles"));
 }
 
 }  // namespace

@@ -139,6 +139,13 @@ std::vector<bool> static_meshes(const Scene& scene, const SceneFrame& frame) {
         const SceneNode& n = scene.nodes[i];
         animated[i] = !n.animation.empty() || (n.parent >= 0 && animated[size_t(n.parent)]);
     }
+    // A skinned mesh moves with its joints, wherever they sit in the hierarchy.
+    for (size_t i = 0; i < scene.nodes.size(); ++i) {
+        const int skin = scene.nodes[i].skin;
+        if (skin < 0 || size_t(skin) >= scene.skins.size()) continue;
+        for (uint32_t joint : scene.skins[size_t(skin)].joints)
+            if (joint < animated.size() && animated[joint]) animated[i] = true;
+    }
     std::vector<bool> include(frame.meshes.size(), true);
     for (size_t m = 0; m < frame.meshes.size(); ++m) {
         uint32_t node = frame.meshes[m].node;
