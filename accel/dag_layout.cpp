@@ -24,7 +24,13 @@ DagLayout lay_out_dag(const std::vector<DagLevelTable>& tables, std::span<const 
             order[level].push_back(id);
         }
     };
-    for (uint32_t r : roots) place(0, r);
+    if (options.one_root_per_entry) {
+        for (uint32_t r : roots)
+            if (r >= tables[0].size()) throw Error(what, "internal: root id outside the level-0 table");
+        order[0].assign(roots.begin(), roots.end());
+    } else {
+        for (uint32_t r : roots) place(0, r);
+    }
     for (int l = 0; l + 1 < levels; ++l) {
         if (options.payload_level >= 0 && l >= options.payload_level) break;
         for (uint32_t id : order[l])
@@ -66,7 +72,11 @@ DagLayout lay_out_dag(const std::vector<DagLevelTable>& tables, std::span<const 
             }
         }
     }
-    for (uint32_t r : roots) out.root_addresses.push_back(uint32_t(address[0][position[0][r]]));
+    if (options.one_root_per_entry) {
+        for (uint64_t a : address[0]) out.root_addresses.push_back(uint32_t(a));
+    } else {
+        for (uint32_t r : roots) out.root_addresses.push_back(uint32_t(address[0][position[0][r]]));
+    }
     return out;
 }
 

@@ -1,95 +1,26 @@
 #include "accel/svdag.hpp"
 #include "accel/child_mask.hpp"
-#include <algorithm>
-#include <array>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include "accel/dag_level_table.hpp"
+#include "accel/svdag_merger.hpp"
 #include "core/error.hpp"
 #include "core/morton.hpp"
 
 namespace gilab {
 
-// Per-level unique-node tables shared by every subtree of a build, and the final
-// layout into the paper's word format.
+// Per-level unique-node tables shared by every subtree of a build (merged by
+// SvdagMerger), and the final layout into the paper's word format.
 class SvdagAssembler {
 public:
-    explicit SvdagAssembler(const VoxelGrid& grid) : grid_(grid), depth_(grid.depth()), tables_(depth_ + 1) {
-        mask_ids_.fill(kInvalidNode);
-    }
+    explicit SvdagAssembler(const VoxelGrid& grid)
+        : grid_(grid), depth_(grid.depth()), tables_(depth_ + 1), merger_(tables_, depth_) {}
 
-    uint32_t leaf_id() {
-        if (tables_[depth_].size() == 0) tables_[depth_].find_or_insert(0, nullptr, 0);
-        return 0;
-    }
-
-    // Id on level depth-1 of a node whose children (all leaves) are given by `mask`.
-    uint32_t bottom_id(uint8_t mask) {
-        uint32_t& id = mask_ids_[mask];
-        if (id == kInvalidNode) {
-            uint32_t leaf = leaf_id();
-            std::array<uint32_t, 8> kids;
-            kids.fill(leaf);
-            id = tables_[depth_ - 1].find_or_insert(mask, kids.data(), child_count(mask));
-        }
-        return id;
-    }
-
-    // Ascending leaf codes → their parents on level depth-1 (codes and ids).
-    void merge_leaves(std::span<const uint64_t> codes, std::vector<uint64_t>& out_codes, std::vector<uint32_t>& out_ids) {
-        out_codes.clear();
-        out_ids.clear();
-        size_t i = 0;
-        while (i < codes.size()) {
-            uint64_t parent = codes[i] >> 3;
-            uint8_t mask = 0;
-            for (; i < codes.size() && (codes[i] >> 3) == parent; ++i) mask |= uint8_t(1u << (codes[i] & 7));
-            out_codes.push_back(parent);
-            out_ids.push_back(bottom_id(mask));
-        }
-    }
-
-    // Nodes on `level` (ascending codes with ids) → their parents on level-1.
-    void merge_up(int level, const std::vector<uint64_t>& codes, const std::vector<uint32_t>& ids,
-                  std::vector<uint64_t>& out_codes, std::vector<uint32_t>& out_ids) {
-        out_codes.clear();
-        out_ids.clear();
-        DagLevelTable& table = tables_[level - 1];
-        size_t i = 0;
-        std::array<uint32_t, 8> kids;
-        while (i < codes.size()) {
-            uint64_t parent = codes[i] >> 3;
-            uint8_t mask = 0;
-            uint32_t count = 0;
-            for (; i < codes.size() && (codes[i] >> 3) == parent; ++i) {
-                mask |= uint8_t(1u << (codes[i] & 7));
-                kids[count++] = ids[i];
-            }
-            out_codes.push_back(parent);
-            out_ids.push_back(table.find_or_insert(mask, kids.data(), count));
-        }
-    }
-
-    // Merges one subtree given by its ascending voxel codes up to level `top`; returns
-    // the id of its root on that level (the codes must all lie in one level-`top` cell).
-    uint32_t add_subtree(std::span<const uint64_t> codes, int top) {
-        if (top == depth_) return leaf_id();
-        merge_leaves(codes, codes_a_, ids_a_);
-        for (int l = depth_ - 1; l > top; --l) {
-            merge_up(l, codes_a_, ids_a_, codes_b_, ids_b_);
-            std::swap(codes_a_, codes_b_);
-            std::swap(ids_a_, ids_b_);
-        }
-        return ids_a_.front();
-    }
-
-    // Nodes given on `level` (ascending codes, ids) merged up to the root.
+    uint32_t leaf_id() { return merger_.leaf_id(); }
+    uint32_t bottom_id(uint8_t mask) { return merger_.bottom_id(mask); }
+    uint32_t add_subtree(std::span<const uint64_t> codes, int top) { return merger_.add_subtree(codes, top); }
     void finish_top(int level, std::vector<uint64_t> codes, std::vector<uint32_t> ids) {
-        for (int l = level; l > 0; --l) {
-            merge_up(l, codes, ids, codes_b_, ids_b_);
-            std::swap(codes, codes_b_);
-            std::swap(ids, ids_b_);
-        }
+        merger_.finish_top(level, std::move(codes), std::move(ids));
     }
 
     DagLevelTable& table(int level) { return tables_[level]; }
@@ -146,25 +77,10 @@ private:
     VoxelGrid grid_;
     int depth_;
     std::vector<DagLevelTable> tables_;
-    std::array<uint32_t, 256> mask_ids_;
-    std::vector<uint64_t> codes_a_, codes_b_;
-    std::vector<uint32_t> ids_a_, ids_b_;
+    SvdagMerger merger_;
 };
 
 namespace {
-
-void check_codes(const VoxelGrid& grid, std::span<const uint64_t> codes, const char* where) {
-    const uint32_t n = grid.resolution;
-    for (size_t i = 0; i < codes.size(); ++i) {
-        if (i > 0 && codes[i] <= codes[i - 1])
-            throw Error(where, "voxel codes must be strictly ascending (Morton order); entry " + std::to_string(i) +
-                                   " is not");
-        UVec3 v = morton_decode(codes[i]);
-        if ((codes[i] >> 63) || v.x >= n || v.y >= n || v.z >= n)
-            throw Error(where, "voxel code " + std::to_string(codes[i]) + " lies outside the " + std::to_string(n) +
-                                   "^3 grid");
-    }
-}
 
 int checked_split_level(const VoxelGrid& grid, int split_level) {
     if (split_level < 0 || split_level > grid.depth())
@@ -239,7 +155,7 @@ Svdag Svdag::from_voxels(const VoxelGrid& grid, std::span<const uint64_t> codes,
     Stopwatch clock;
     grid.validate("SVDAG");
     checked_split_level(grid, split_level);
-    check_codes(grid, codes, "SVDAG");
+    check_voxel_codes(grid, codes, "SVDAG");
     const int depth = grid.depth();
     const int shift = 3 * (depth - split_level);
     SvdagAssembler as(grid);
@@ -289,7 +205,7 @@ Svdag Svdag::from_slices(const VoxelGrid& grid, int split_level, std::span<const
         std::vector<uint64_t> codes = slice(cells[c]);
         slice_ms += t.elapsed_ms();
         if (codes.empty()) continue;
-        check_codes(grid, codes, "SVDAG");
+        check_voxel_codes(grid, codes, "SVDAG");
         if ((codes.front() >> shift) != cells[c] || (codes.back() >> shift) != cells[c])
             throw Error("SVDAG", "a slice holds voxels outside its split cell " + std::to_string(cells[c]));
         Stopwatch m;
