@@ -3,6 +3,7 @@
 #include "accel/esvo.hpp"
 #include "accel/svdag.hpp"
 #include "accel/svo.hpp"
+#include "accel/temporal_svdag.hpp"
 
 namespace gilab {
 namespace {
@@ -17,8 +18,10 @@ struct EsvoAccess {
     uint8_t mask(uint32_t n) const { return s.valid_mask(n); }
     uint32_t child(uint32_t n, int slot) const { return s.child(n, slot); }
 };
+// Svdag and TemporalSvdag share the word format and its accessors.
+template <class Dag>
 struct DagAccess {
-    const Svdag& s;
+    const Dag& s;
     uint8_t mask(uint32_t n) const { return s.mask(n); }
     uint32_t child(uint32_t n, int slot) const { return s.child(n, slot); }
 };
@@ -103,7 +106,13 @@ VoxelRayHit trace_voxel_ray(const Esvo& esvo, const Ray& ray) {
 }
 
 VoxelRayHit trace_voxel_ray(const Svdag& dag, const Ray& ray) {
-    return traverse(DagAccess{dag}, dag.grid(), dag.depth(), dag.empty(), dag.root(), ray);
+    return traverse(DagAccess<Svdag>{dag}, dag.grid(), dag.depth(), dag.empty(), dag.root(), ray);
+}
+
+VoxelRayHit trace_voxel_ray(const TemporalSvdag& dag, size_t frame, const Ray& ray) {
+    const uint32_t root = dag.root(frame);
+    const bool empty = root == TemporalSvdag::kEmptyFrame;
+    return traverse(DagAccess<TemporalSvdag>{dag}, dag.grid(), dag.depth(), empty, root, ray);
 }
 
 }  // namespace gilab

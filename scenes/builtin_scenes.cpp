@@ -2,6 +2,7 @@
 
 #include <array>
 #include <map>
+#include "scenes/fire_scene.hpp"
 #include "scenes/shadow_scenes.hpp"
 
 namespace gilab {
@@ -161,6 +162,7 @@ const std::vector<BuiltinScene>& builtin_scenes() {
          make_villa},
         {"fbm_terrain", "open 256x256 ridged-fBm heightfield, 200 m across, 25 m amplitude; low sun",
          [] { return make_fbm_terrain(); }},
+        {"fire", "4000 seeded particles rising from logs; 100 frames at 30 fps", [] { return make_fire_scene(); }},
     };
     return scenes;
 }

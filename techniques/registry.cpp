@@ -1,6 +1,7 @@
 #include "techniques/technique.hpp"
 
 #include "core/error.hpp"
+#include "techniques/dag_raycast/dag_raycast_technique.hpp"
 #include "techniques/dag_shadows/dag_shadows_technique.hpp"
 #include "techniques/path_tracer/path_tracer.hpp"
 #include "techniques/photon_mapping/photon_technique.hpp"
@@ -36,6 +37,7 @@ const TechniqueRegistry& TechniqueRegistry::builtin() {
         register_photon_mapping(r);
         register_vct(r);
         register_dag_shadows(r);
+        register_dag_raycast(r);
         return r;
     }();
     return registry;

@@ -1,0 +1,52 @@
+#pragma once
+// Ray casting through a time-correlated multi-frame DAG (P2 §4, Table 6): prepare
+// voxelizes every frame of the scene's animation into one DAG with a root per frame;
+// update(t) only selects the root of the nearest frame (nothing is rebuilt per frame,
+// which is the point of the structure); render casts one primary ray per pixel through
+// that root, shades the hit with the entered voxel face's normal and one light (N·L plus
+// a small ambient term) and traces a shadow ray through the same frame's DAG.
+//
+// Settings: see dag_raycast_settings.hpp. Layers: color (grey Lambertian voxels: the
+// voxels carry no material), normal (the face normal; 0 for background), depth (distance
+// from the eye to where the ray enters the hit voxel; 0 for background), visibility
+// (1 channel: the shadow ray's answer; 0 for background and surfaces facing away).
+// Without a point or directional light, a headlight at the eye stands in.
+#include <string>
+#include "core/light.hpp"
+#include "techniques/dag_raycast/animation_dag.hpp"
+#include "techniques/dag_raycast/dag_raycast_settings.hpp"
+#include "techniques/technique.hpp"
+
+namespace gilab {
+
+class DagRaycastTechnique final : public Technique {
+public:
+    std::string name() const override { return "dag_raycast"; }
+    void prepare(const Scene& scene, const Settings& settings) override;
+    // Selects frame round(t · fps), clamped to the frames built (the scene's animation
+    // clamps the same way).
+    void update(double time) override;
+    void render(const ViewSet& views, std::vector<Film>& films) override;
+    Stats stats() const override;
+
+    const TemporalSvdag& dag() const { return animation_.dag; }
+    size_t frame() const { return frame_; }
+    size_t frame_count() const { return animation_.times.size(); }
+    double fps() const { return fps_; }
+
+private:
+    bool prepared() const { return !animation_.times.empty(); }
+    // The shading light of the current frame, or nullptr for the headlight.
+    const PunctualLight* light() const;
+
+    DagRaycastSettings settings_;
+    AnimationDag animation_;
+    double fps_ = 30.0;
+    int light_index_ = -1;  // into each frame's lights; -1 = headlight
+    size_t frame_ = 0;
+    Stats stats_;
+};
+
+void register_dag_raycast(TechniqueRegistry& registry);
+
+}  // namespace gilab
