@@ -10,6 +10,7 @@ const ExperimentRegistry& ExperimentRegistry::builtin() {
         register_stereo_experiments(r);
         register_dag_experiments(r);
         register_shadow_dag_experiments(r);
+        register_dynamic_dag_experiments(r);
         register_vct_experiments(r);
         return r;
     }();
