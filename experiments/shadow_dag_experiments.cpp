@@ -251,21 +251,27 @@ ExperimentOutput run_fig15(const ExperimentContext& ctx) {
     t.title = "Fig. 15 — growth factor of the storage per doubling of the resolution";
     t.columns = {"scene", "paper scene", "N → 2N", "S1 growth", "S2 growth", "S3 growth",
                  "paper S1 growth", "paper S2 growth", "paper S3 growth"};
-    Plot plot;
-    plot.title = "Storage growth per resolution doubling (Fig. 15)";
-    plot.x_label = "resolution N (voxels per axis)";
-    plot.y_label = "size(2N) / size(N)";
-    plot.log_x = true;
+    // One plot per structure, each scene in the colour of the paper scene it stands for.
+    auto growth_plot = [](const std::string& structure) {
+        Plot p;
+        p.title = structure + ": storage growth per resolution doubling (Fig. 15)";
+        p.x_label = "resolution N (voxels per axis)";
+        p.y_label = "size(2N) / size(N)";
+        p.log_x = true;
+        return p;
+    };
+    Plot plot_s2 = growth_plot("S2 shadow DAG"), plot_s3 = growth_plot("S3 double-depth DAG");
+    const std::map<std::string, int> paper_color = {{"Citadel", 0}, {"Villa", 1}, {"Terrain", 2}};
     const auto scenes = open_shadow_scenes(ctx, out);
-    int color = 0;
     for (const auto& s : scenes) {
         std::vector<double> s2, s3;
         for (uint32_t res : sizes) {
             s2.push_back(double(build_and_measure(*s, res, false, ctx).bytes));
             s3.push_back(double(build_and_measure(*s, res, true, ctx).bytes));
         }
-        PlotSeries g2{s->spec.scene + " S2", {}, {}, false, true, color};
-        PlotSeries g3{s->spec.scene + " S3", {}, {}, false, true, color + 1};
+        const int color = paper_color.at(s->spec.paper_scene) + (s->spec.scene == "fbm_terrain" ? 1 : 0) * 3;
+        PlotSeries g2{s->spec.scene, {}, {}, false, true, color};
+        PlotSeries g3{s->spec.scene, {}, {}, false, true, color};
         for (size_t i = 0; i + 1 < sizes.size(); ++i) {
             if (sizes[i + 1] != 2 * sizes[i]) continue;
             // The paper's doublings are 1000→2000→4000 in Table 4.
@@ -286,14 +292,13 @@ ExperimentOutput run_fig15(const ExperimentContext& ctx) {
             g3.x.push_back(sizes[i]);
             g3.y.push_back(s3[i + 1] / s3[i]);
         }
-        plot.series.push_back(g2);
-        plot.series.push_back(g3);
-        color += 2;
+        plot_s2.series.push_back(g2);
+        plot_s3.series.push_back(g3);
     }
     // The paper's curves from Table 4 (1000→2000, 2000→4000; 4000→16000 as two doublings).
     for (const std::string ps : {"Citadel", "Villa", "Terrain"}) {
-        PlotSeries p{"paper " + ps + " S2", {}, {}, true, true, -1};
-        PlotSeries q{"paper " + ps + " S3", {}, {}, true, true, -1};
+        PlotSeries p{"paper " + ps, {}, {}, true, true, paper_color.at(ps)};
+        PlotSeries q{"paper " + ps, {}, {}, true, true, paper_color.at(ps)};
         const uint32_t from[] = {1000, 2000, 4000};
         const uint32_t to[] = {2000, 4000, 16000};
         for (int k = 0; k < 3; ++k) {
@@ -304,14 +309,15 @@ ExperimentOutput run_fig15(const ExperimentContext& ctx) {
             q.x.push_back(from[k]);
             q.y.push_back(std::pow(b->s3 / a->s3, 1.0 / steps));
         }
-        plot.series.push_back(p);
-        plot.series.push_back(q);
+        plot_s2.series.push_back(p);
+        plot_s3.series.push_back(q);
     }
-    PlotSeries s1{"S1 shadow map (4, by construction)", {double(sizes.front()), double(sizes[sizes.size() - 2])},
-                  {4.0, 4.0}, false, false, -1};
-    plot.series.push_back(s1);
+    for (Plot* p : {&plot_s2, &plot_s3})
+        p->series.push_back(PlotSeries{"S1 (4, by construction)", {double(sizes.front()), double(sizes[sizes.size() - 2])},
+                                       {4.0, 4.0}, false, false, 6});
     out.tables.push_back(t);
-    out.plots.push_back({"fig15_growth", plot});
+    out.plots.push_back({"fig15_growth_s2", plot_s2});
+    out.plots.push_back({"fig15_growth_s3", plot_s3});
     out.notes.push_back(kLightSpaceNote);
     out.notes.push_back(
         "Paper growth factors are computed from its Table 4 (the figure itself gives no numbers); its 4000→16000 step is "

@@ -101,7 +101,7 @@ TEST(ShadowDagExperiments, Fig15Growth) {
         }
     }
     EXPECT_TRUE(villa);
-    ASSERT_EQ(out.plots.size(), 1u);
+    ASSERT_EQ(out.plots.size(), 2u);  // S2 and S3
 }
 
 TEST(ShadowDagExperiments, Fig16To18ShadowTimes) {
