@@ -7,7 +7,7 @@
 #include <filesystem>
 #include "experiments/experiment.hpp"
 #include "experiments/plot.hpp"
-#include "tests/test_support.hpp"
+#include "tests/experiment_test_support.hpp"
 
 namespace {
 
@@ -24,26 +24,7 @@ const ExperimentRegistry& dynamic_registry() {
     return registry;
 }
 
-ExperimentOutput run_quick(const std::string& name) {
-    ExperimentContext ctx;
-    ctx.quick = true;
-    ctx.output_dir = test::temp_dir("dynamic_dag_experiments_" + name);
-    ctx.assets = AssetPaths::from_environment();
-    ExperimentOutput out = run_and_write(dynamic_registry().get(name), ctx);
-    for (const char* file : {"results.csv", "results.json", "table.md"})
-        EXPECT_TRUE(fs::exists(ctx.output_dir / file)) << name << ": " << file;
-    if (plotting_available()) {
-        for (const auto& [plot_name, plot] : out.plots)
-            EXPECT_TRUE(fs::exists(ctx.output_dir / (plot_name + ".svg"))) << plot_name;
-    }
-    EXPECT_FALSE(out.tables.empty());
-    for (const ResultTable& t : out.tables) {
-        EXPECT_FALSE(t.rows.empty()) << t.title;
-        for (const json& row : t.rows)
-            for (const std::string& c : t.columns) EXPECT_TRUE(row.contains(c)) << t.title << ": " << c;
-    }
-    return out;
-}
+ExperimentOutput run_quick(const std::string& name) { return test::run_quick_experiment(dynamic_registry(), name); }
 
 std::vector<const json*> rows_of(const ResultTable& t, const std::string& scene) {
     std::vector<const json*> rows;

@@ -8,7 +8,7 @@
 #include <fstream>
 #include "experiments/experiment.hpp"
 #include "experiments/plot.hpp"
-#include "tests/test_support.hpp"
+#include "tests/experiment_test_support.hpp"
 
 namespace {
 
@@ -25,26 +25,7 @@ const ExperimentRegistry& shadow_registry() {
     return registry;
 }
 
-ExperimentOutput run_quick(const std::string& name) {
-    ExperimentContext ctx;
-    ctx.quick = true;
-    ctx.output_dir = test::temp_dir("shadow_dag_experiments_" + name);
-    ctx.assets = AssetPaths::from_environment();
-    ExperimentOutput out = run_and_write(shadow_registry().get(name), ctx);
-    for (const char* file : {"results.csv", "results.json", "table.md"})
-        EXPECT_TRUE(fs::exists(ctx.output_dir / file)) << name << ": " << file;
-    if (plotting_available()) {
-        for (const auto& [plot_name, plot] : out.plots)
-            EXPECT_TRUE(fs::exists(ctx.output_dir / (plot_name + ".svg"))) << plot_name;
-    }
-    EXPECT_FALSE(out.tables.empty());
-    for (const ResultTable& t : out.tables) {
-        EXPECT_FALSE(t.rows.empty()) << t.title;
-        for (const json& row : t.rows)
-            for (const std::string& c : t.columns) EXPECT_TRUE(row.contains(c)) << t.title << ": " << c;
-    }
-    return out;
-}
+ExperimentOutput run_quick(const std::string& name) { return test::run_quick_experiment(shadow_registry(), name); }
 
 const json* find_row(const ResultTable& t, const std::string& scene, uint32_t n) {
     for (const json& row : t.rows)
