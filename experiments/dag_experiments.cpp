@@ -23,6 +23,7 @@
 #include "core/stats.hpp"
 #include "core/voxelizer.hpp"
 #include "experiments/experiment.hpp"
+#include "experiments/measures.hpp"
 #include "scenes/scene_library.hpp"
 
 namespace gilab {
@@ -156,26 +157,9 @@ const char* kGridNote =
 
 // ---- Helpers ----
 
-double median(std::vector<double> v) {
-    if (v.empty()) return 0;
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
-double mb(double bytes) { return bytes / 1e6; }
-double mib(double bytes) { return bytes / double(1 << 20); }
-json ratio(double a, double b) { return b > 0 ? json(a / b) : json(nullptr); }
 std::string cube(uint32_t n) { return std::to_string(n) + "³"; }
 
-// 1-minute load average when a timed experiment starts: other work on a shared machine
-// slows timings, and this says how much was running.
-double load_average() {
-    std::ifstream in("/proc/loadavg");
-    double load = -1;
-    in >> load;
-    return load;
-}
 
 size_t available_memory_bytes() {
     std::ifstream meminfo("/proc/meminfo");

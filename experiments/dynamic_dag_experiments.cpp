@@ -22,6 +22,7 @@
 #include "core/stats.hpp"
 #include "core/voxelizer.hpp"
 #include "experiments/experiment.hpp"
+#include "experiments/measures.hpp"
 #include "scenes/scene_library.hpp"
 #include "techniques/dag_raycast/animation_dag.hpp"
 #include "techniques/technique.hpp"
@@ -69,23 +70,8 @@ constexpr double kKampeMB = 1.86;
 constexpr int kKampeFrames = 70;
 constexpr uint32_t kKampeResolution = 2048;
 
-double mb(double bytes) { return bytes / 1e6; }
-double mib(double bytes) { return bytes / double(1 << 20); }
-json ratio(double a, double b) { return b > 0 ? json(a / b) : json(nullptr); }
 
-double load_average() {
-    std::ifstream in("/proc/loadavg");
-    double one_minute = 0;
-    in >> one_minute;
-    return one_minute;
-}
 
-double median(std::vector<double> v) {
-    if (v.empty()) return 0;
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 struct OpenedDynamicScene {
     std::string name, paper_scene;

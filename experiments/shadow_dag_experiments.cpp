@@ -16,6 +16,7 @@
 #include "core/scene.hpp"
 #include "core/stats.hpp"
 #include "experiments/experiment.hpp"
+#include "experiments/measures.hpp"
 #include "scenes/scene_library.hpp"
 #include "techniques/technique.hpp"
 
@@ -139,9 +140,6 @@ DagFigures build_and_measure(const LoadedScene& s, uint32_t res, bool double_dep
     return f;
 }
 
-double mb(double bytes) { return bytes / 1e6; }
-double mib(double bytes) { return bytes / double(1 << 20); }
-json ratio(double a, double b) { return b > 0 ? json(a / b) : json(nullptr); }
 
 const char* kLightSpaceNote =
     "Light space: the scene's first directional or spot light (every scene here has a directional sun), an orthographic box fitted to the scene's bounding box (0.1 % "
@@ -425,12 +423,6 @@ ExperimentOutput run_fig16_18(const ExperimentContext& ctx) {
             double s = 0;
             for (double x : v) s += x;
             return v.empty() ? 0.0 : s / double(v.size());
-        };
-        auto median = [](std::vector<double> v) {
-            if (v.empty()) return 0.0;
-            std::sort(v.begin(), v.end());
-            const size_t n = v.size();
-            return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
         };
         const double map_median = median(ms[1]);
         Plot plot;
