@@ -35,40 +35,6 @@ std::vector<uint64_t> moving_sphere_frame(int frame) {
     return voxelize(soup.positions, soup.triangles, gilab::test::unit_grid(kResolution)).codes;
 }
 
-// Rays from a ring of eye points around the unit cube towards random targets inside it,
-// plus rays starting inside the grid and axis-parallel rays (zero direction components).
-std::vector<Ray> test_rays() {
-    std::mt19937 rng(5);
-    std::vector<Ray> rays;
-    for (int e = 0; e < 6; ++e) {
-        const float a = 2.0f * kPi * float(e) / 6.0f;
-        const Vec3 eye(0.5f + 1.3f * std::cos(a), 0.5f + 0.4f * float(e % 3 - 1), 0.5f + 1.3f * std::sin(a));
-        for (int i = 0; i < 400; ++i) {
-            Ray r;
-            r.origin = eye;
-            r.direction = gilab::test::random_point(rng, Vec3(0.02f), Vec3(0.98f)) - eye;
-            rays.push_back(r);
-        }
-    }
-    for (int i = 0; i < 400; ++i) {
-        Ray r;
-        r.origin = gilab::test::random_point(rng, Vec3(0.1f), Vec3(0.9f));
-        r.direction = gilab::test::random_point(rng, Vec3(-1.0f), Vec3(1.0f));
-        r.tmin = 0.01f;
-        rays.push_back(r);
-    }
-    for (int i = 0; i < 300; ++i) {
-        Ray r;
-        r.origin = gilab::test::random_point(rng, Vec3(0.0f), Vec3(1.0f));
-        const int axis = i % 3;
-        r.origin[axis] = (i / 3) % 2 ? 1.5f : -0.5f;
-        r.direction = Vec3(0);
-        r.direction[axis] = (i / 3) % 2 ? -1.0f : 1.0f;
-        rays.push_back(r);
-    }
-    return rays;
-}
-
 // The frame's rays through `temporal` and through the frame's own SVDAG agree exactly.
 // Returns the number of hits, so callers can check the rays met something.
 int expect_same_hits(const TemporalSvdag& temporal, size_t frame, const Svdag& own, const std::vector<Ray>& rays) {
@@ -97,7 +63,7 @@ TEST(TemporalTraversal, EveryFrameMatchesItsOwnSvdag) {
     for (const auto& codes : frames) builder.append_frame(codes);
     const TemporalSvdag temporal = builder.lay_out();
     ASSERT_EQ(temporal.frame_count(), frames.size());
-    const std::vector<Ray> rays = test_rays();
+    const std::vector<Ray> rays = gilab::test::traversal_test_rays();
     for (size_t f = 0; f < frames.size(); ++f) {
         const Svdag own = Svdag::from_voxels(grid, frames[f]);
         const int hits = expect_same_hits(temporal, f, own, rays);
@@ -126,7 +92,7 @@ TEST(TemporalTraversal, EmptyFrameIsNeverHit) {
     builder.append_frame(std::vector<uint64_t>{});
     const TemporalSvdag temporal = builder.lay_out();
     int hits = 0;
-    for (const Ray& r : test_rays()) {
+    for (const Ray& r : gilab::test::traversal_test_rays()) {
         EXPECT_FALSE(trace_voxel_ray(temporal, 1, r).hit);
         hits += trace_voxel_ray(temporal, 0, r).hit;
     }

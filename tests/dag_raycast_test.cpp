@@ -255,3 +255,65 @@ TEST(DagRaycast, BadSettingsAreErrors) {
     auto fresh = TechniqueRegistry::builtin().create("dag_raycast");
     EXPECT_NE(test::error_of([&] { fresh->update(0.1); }).find("before prepare"), std::string::npos);
 }
+
+// The sliding box's sun: the shadow DAG (auto for a directional light) and shadow rays
+// through the frame's DAG agree on the floor, where voxel faces and triangles coincide;
+// the box's shadow moves with it; `none` lights every surface facing the sun.
+TEST(DagRaycast, ShadowDagAndShadowRaysAgreeOnTheFloor) {
+    Scene scene = sliding_box_scene();
+    scene.lights[0].direction = glm::normalize(Vec3(-1.0f, -1.0f, -0.3f));  // long shadows along -x
+    auto by_dag = prepared(scene, {{"resolution", 128}});
+    auto by_ray = prepared(scene, {{"resolution", 128}, {"shadows", "dag_ray"}});
+    auto unshadowed = prepared(scene, {{"resolution", 128}, {"shadows", "none"}});
+    EXPECT_EQ(by_dag->stats().get("shadow_dag_resolution"), 128.0);
+    EXPECT_GT(by_dag->stats().get("shadow_dag_bytes"), 0.0);
+    // From above, so the shadow behind the box is in view.
+    const EyeCamera camera = EyeCamera::look_at(Vec3(0, 3.0f, 0.5f), Vec3(0), Vec3(0, 1, 0), 50.0f, 128, 96);
+    std::vector<float> shadow_at_start;
+    for (double t : {0.0, 1.0}) {
+        by_dag->update(t);
+        by_ray->update(t);
+        unshadowed->update(t);
+        const Film a = render(*by_dag, camera), b = render(*by_ray, camera), c = render(*unshadowed, camera);
+        EXPECT_EQ(a.metadata.at("shadows"), "shadow_dag");
+        EXPECT_EQ(b.metadata.at("shadows"), "dag_ray");
+        const auto& va = a.layer("visibility").data;
+        const auto& vb = b.layer("visibility").data;
+        const auto& vc = c.layer("visibility").data;
+        const auto& normal = a.layer("normal").data;
+        size_t floor = 0, agree = 0, shadowed = 0;
+        std::vector<float> shadow(va.size(), 0.0f);
+        for (size_t i = 0; i < va.size(); ++i) {
+            if (normal[3 * i + 1] < 0.99f) continue;  // floor and box top: faces pointing up
+            ++floor;
+            agree += (va[i] > 0.5f) == (vb[i] > 0.5f);
+            shadowed += va[i] < 0.5f;
+            shadow[i] = va[i] < 0.5f ? 1.0f : 0.0f;
+            EXPECT_EQ(vc[i], 1.0f);
+        }
+        EXPECT_GT(floor, va.size() / 3);
+        EXPECT_GT(shadowed, floor / 100) << "the box should shadow part of the floor at t = " << t;
+        EXPECT_GE(agree, floor - floor / 50) << "t = " << t;
+        if (t == 0.0)
+            shadow_at_start = shadow;
+        else
+            EXPECT_NE(shadow, shadow_at_start) << "the shadow should move with the box";
+    }
+}
+
+TEST(DagRaycast, ShadowSettingsAreCheckedAgainstTheLight) {
+    Scene scene = sliding_box_scene();
+    scene.lights[0].type = LightType::Point;
+    scene.lights[0].position = Vec3(0, 2, 0);
+    auto error = [&](const json& settings) {
+        auto t = TechniqueRegistry::builtin().create("dag_raycast");
+        return test::error_of([&] { t->prepare(scene, Settings(settings)); });
+    };
+    EXPECT_NE(error({{"resolution", 16}, {"shadows", "shadow_dag"}}).find("directional or spot"), std::string::npos);
+    EXPECT_NE(error({{"resolution", 16}, {"shadows", "sometimes"}}).find("dag_raycast.shadows"), std::string::npos);
+    EXPECT_NE(error({{"resolution", 16}, {"shadow_resolution", 3}}).find("dag_raycast.shadow_resolution"),
+              std::string::npos);
+    // A point light's auto choice is a shadow ray through the frame's DAG.
+    auto t = prepared(scene, {{"resolution", 32}});
+    EXPECT_EQ(render(*t, scene_camera(scene, 16, 12)).metadata.at("shadows"), "dag_ray");
+}

@@ -7,6 +7,7 @@
 #include <vector>
 #include "core/math.hpp"
 #include "core/morton.hpp"
+#include "core/ray.hpp"
 #include "core/voxel_grid.hpp"
 
 namespace gilab::test {
@@ -73,6 +74,40 @@ inline VoxelGrid unit_grid(uint32_t n) {
     g.extent = 1.0f;
     g.resolution = n;
     return g;
+}
+
+// Rays from a ring of eye points around the unit cube towards random targets inside it,
+// plus rays starting inside the grid and axis-parallel rays (zero direction components).
+inline std::vector<Ray> traversal_test_rays() {
+    std::mt19937 rng(5);
+    std::vector<Ray> rays;
+    for (int e = 0; e < 6; ++e) {
+        const float a = 2.0f * kPi * float(e) / 6.0f;
+        const Vec3 eye(0.5f + 1.3f * std::cos(a), 0.5f + 0.4f * float(e % 3 - 1), 0.5f + 1.3f * std::sin(a));
+        for (int i = 0; i < 400; ++i) {
+            Ray r;
+            r.origin = eye;
+            r.direction = random_point(rng, Vec3(0.02f), Vec3(0.98f)) - eye;
+            rays.push_back(r);
+        }
+    }
+    for (int i = 0; i < 400; ++i) {
+        Ray r;
+        r.origin = random_point(rng, Vec3(0.1f), Vec3(0.9f));
+        r.direction = random_point(rng, Vec3(-1.0f), Vec3(1.0f));
+        r.tmin = 0.01f;
+        rays.push_back(r);
+    }
+    for (int i = 0; i < 300; ++i) {
+        Ray r;
+        r.origin = random_point(rng, Vec3(0.0f), Vec3(1.0f));
+        const int axis = i % 3;
+        r.origin[axis] = (i / 3) % 2 ? 1.5f : -0.5f;
+        r.direction = Vec3(0);
+        r.direction[axis] = (i / 3) % 2 ? -1.0f : 1.0f;
+        rays.push_back(r);
+    }
+    return rays;
 }
 
 }  // namespace gilab::test

@@ -16,10 +16,27 @@ DagBuildMode parse_build(const std::string& s) {
     throw Error(key("build"), "unknown value '" + s + "' (incremental, all_at_once)");
 }
 
+DagShadowSource parse_shadows(const std::string& s) {
+    for (DagShadowSource v : {DagShadowSource::Auto, DagShadowSource::ShadowDag, DagShadowSource::DagRay,
+                              DagShadowSource::None})
+        if (s == to_string(v)) return v;
+    throw Error(key("shadows"), "unknown value '" + s + "' (auto, shadow_dag, dag_ray, none)");
+}
+
 }  // namespace
 
 const char* to_string(DagBuildMode mode) {
     return mode == DagBuildMode::Incremental ? "incremental" : "all_at_once";
+}
+
+const char* to_string(DagShadowSource source) {
+    switch (source) {
+        case DagShadowSource::Auto: return "auto";
+        case DagShadowSource::ShadowDag: return "shadow_dag";
+        case DagShadowSource::DagRay: return "dag_ray";
+        case DagShadowSource::None: return "none";
+    }
+    return "?";
 }
 
 DagRaycastSettings DagRaycastSettings::from(const Settings& s) {
@@ -41,6 +58,12 @@ DagRaycastSettings DagRaycastSettings::from(const Settings& s) {
     if (o.light < -1) throw Error(key("light"), "must be -1 (automatic) or a light index");
     o.ambient = s.get<float>("ambient", o.ambient);
     if (!(o.ambient >= 0 && o.ambient <= 1)) throw Error(key("ambient"), "must be in [0, 1]");
+    o.shadows = parse_shadows(s.get<std::string>("shadows", to_string(o.shadows)));
+    const int64_t shadow_resolution = s.get<int64_t>("shadow_resolution", o.shadow_resolution);
+    if (shadow_resolution != 0 && (shadow_resolution < 8 || shadow_resolution > 131072))
+        throw Error(key("shadow_resolution"),
+                    "must be 0 (the voxel resolution) or in 8..131072, not " + std::to_string(shadow_resolution));
+    o.shadow_resolution = uint32_t(shadow_resolution);
     o.tile_size = s.get<int>("tile_size", o.tile_size);
     if (o.tile_size < 1 || o.tile_size > 1024) throw Error(key("tile_size"), "must be in 1..1024");
     // Nothing here is random; the seed every render passes is read so it is not an

@@ -7,7 +7,10 @@
 // shows the scene at k / fps), build (incremental | all_at_once: how the frames are merged,
 // P2 §4 (b) / (a)), light (-1: the scene's first point or directional light, else its
 // index), ambient (0.05: unshadowed light as a fraction of the light's irradiance),
-// tile_size (16: image tile), seed (recorded only: nothing is random), spp (only 1: one
+// shadows (auto | shadow_dag | dag_ray | none: auto takes the shadow DAG for directional
+// and spot lights, whose light space it is defined over, and shadow rays through the
+// frame's DAG for point lights), shadow_resolution (0: the voxel resolution; voxels per
+// axis of each frame's shadow DAG), tile_size (16: image tile), seed (recorded only: nothing is random), spp (only 1: one
 // primary ray per pixel).
 #include <cstdint>
 #include "core/settings.hpp"
@@ -17,6 +20,15 @@ namespace gilab {
 enum class DagBuildMode { Incremental, AllAtOnce };
 const char* to_string(DagBuildMode mode);
 
+// Where a lit surface's visibility comes from.
+enum class DagShadowSource {
+    Auto,       // ShadowDag for directional and spot lights, DagRay for point lights
+    ShadowDag,  // the shadow DAG of the frame (P2 §3), built at prepare
+    DagRay,     // a shadow ray through the frame's own multi-frame DAG root
+    None,       // every surface facing the light is lit
+};
+const char* to_string(DagShadowSource source);
+
 struct DagRaycastSettings {
     uint32_t resolution = 256;
     int frames = 0;
@@ -24,6 +36,8 @@ struct DagRaycastSettings {
     DagBuildMode build = DagBuildMode::Incremental;
     int light = -1;
     float ambient = 0.05f;
+    DagShadowSource shadows = DagShadowSource::Auto;
+    uint32_t shadow_resolution = 0;
     int tile_size = 16;
     uint64_t seed = 1;
 

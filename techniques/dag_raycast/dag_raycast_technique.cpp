@@ -3,10 +3,11 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include "accel/voxel_ray_traversal.hpp"
+#include "accel/dag_ray_caster.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"
 #include "core/parallel.hpp"
+#include "core/traced_scene.hpp"
 #include "techniques/dag_raycast/voxel_face.hpp"
 
 namespace gilab {
@@ -16,15 +17,15 @@ constexpr const char* kName = "dag_raycast";
 constexpr float kAlbedo = 0.8f;  // voxels carry no material: one grey for all
 
 // Where the light comes from at p and how much arrives on a surface facing it.
-struct LightSample {
+struct LightArrival {
     Vec3 wi{0};
     Vec3 irradiance{0};
     float distance = kInfinity;
     bool needs_shadow_ray = true;
 };
 
-LightSample sample_light(const PunctualLight* light, const Vec3& p, const Vec3& eye) {
-    LightSample s;
+LightArrival sample_light(const PunctualLight* light, const Vec3& p, const Vec3& eye) {
+    LightArrival s;
     if (!light) {
         // The headlight sits at the eye, which sees p: nothing can shadow it.
         const Vec3 d = eye - p;
@@ -48,12 +49,17 @@ LightSample sample_light(const PunctualLight* light, const Vec3& p, const Vec3& 
     s.distance = std::sqrt(d2);
     s.wi = d / s.distance;
     s.irradiance = light->intensity / d2;
+    if (light->type == LightType::Spot)
+        s.irradiance *= spot_falloff(*light, glm::dot(-s.wi, glm::normalize(light->direction)));
     return s;
 }
 
-// Index of the shading light among the scene's lights, or -1 for the headlight.
+// Index of the shading light among the scene's lights, or -1 for the headlight: the
+// requested one, else the first point, spot or directional light.
 int choose_light(const std::vector<PunctualLight>& lights, int requested, const std::string& where) {
-    auto usable = [](const PunctualLight& l) { return l.type == LightType::Point || l.type == LightType::Directional; };
+    auto usable = [](const PunctualLight& l) {
+        return l.type == LightType::Point || l.type == LightType::Spot || l.type == LightType::Directional;
+    };
     if (requested >= 0) {
         if (requested >= int(lights.size()))
             throw Error("dag_raycast.light", "the scene " + where + " has " + std::to_string(lights.size()) +
@@ -62,7 +68,7 @@ int choose_light(const std::vector<PunctualLight>& lights, int requested, const 
         if (!usable(lights[size_t(requested)]))
             throw Error("dag_raycast.light", "light " + std::to_string(requested) + " of " + where + " is a " +
                                                  to_string(lights[size_t(requested)].type) +
-                                                 " light; only point and directional lights are supported");
+                                                 " light; only point, spot and directional lights are supported");
         return requested;
     }
     for (size_t i = 0; i < lights.size(); ++i)
@@ -102,7 +108,41 @@ void DagRaycastTechnique::prepare(const Scene& scene, const Settings& settings) 
     stats_.set("pointers", double(dag.pointer_count()));
     stats_.set("bytes_32bit", double(dag.bytes()));
     stats_.set("frame", 0);
+    prepare_shadows(scene, where);
     stats_.set("prepare_ms", watch.elapsed_ms());
+}
+
+void DagRaycastTechnique::prepare_shadows(const Scene& scene, const std::string& where) {
+    shadow_dags_.clear();
+    const PunctualLight* l = light();
+    const bool has_light_space = l && (l->type == LightType::Directional || l->type == LightType::Spot);
+    shadows_ = settings_.shadows;
+    if (shadows_ == DagShadowSource::Auto)
+        shadows_ = !l ? DagShadowSource::None : has_light_space ? DagShadowSource::ShadowDag : DagShadowSource::DagRay;
+    if (shadows_ == DagShadowSource::ShadowDag && !has_light_space)
+        throw Error("dag_raycast.shadows", std::string("the shadow DAG needs a directional or spot light, and the "
+                                                       "shading light of ") +
+                                               where + " is " + (l ? std::string("a point light") : "the headlight"));
+    if (shadows_ == DagShadowSource::DagRay && !l) shadows_ = DagShadowSource::None;  // nothing can shadow it
+    if (shadows_ != DagShadowSource::ShadowDag) return;
+
+    // One shadow DAG per frame over that frame's geometry and light, as the frames'
+    // voxels were: the renderer then only looks up the frame's DAG.
+    Stopwatch watch;
+    ShadowDagOptions o;
+    o.resolution = settings_.shadow_resolution ? settings_.shadow_resolution : settings_.resolution;
+    TracedScene traced;
+    traced.load(scene);
+    size_t bytes = 0;
+    for (size_t k = 0; k < animation_.times.size(); ++k) {
+        traced.set_time(animation_.times[k]);
+        shadow_dags_.push_back(
+            ShadowDag::build(scene, traced.tracer(), animation_.lights[k][size_t(light_index_)], o));
+        bytes += shadow_dags_.back().bytes();
+    }
+    stats_.set("shadow_dag_resolution", double(o.resolution));
+    stats_.set("shadow_dag_build_ms", watch.elapsed_ms());
+    stats_.set("shadow_dag_bytes", double(bytes));
 }
 
 const PunctualLight* DagRaycastTechnique::light() const {
@@ -126,10 +166,11 @@ void DagRaycastTechnique::render(const ViewSet& views, std::vector<Film>& films)
     Stopwatch total;
     const TemporalSvdag& dag = animation_.dag;
     const size_t frame = frame_;
+    const DagWordsView frame_dag = dag_view(dag, frame);
     const PunctualLight* shading_light = light();
     const float voxel = float(dag.grid().voxel_size());
     const Vec3 ambient_scale(settings_.ambient);
-    std::atomic<uint64_t> rays{0};
+    std::atomic<uint64_t> rays{0}, primary_visits{0};
     films.resize(views.views.size());
     for (size_t v = 0; v < views.views.size(); ++v) {
         const EyeCamera& cam = views.views[v];
@@ -139,29 +180,34 @@ void DagRaycastTechnique::render(const ViewSet& views, std::vector<Film>& films)
         film.add_layer("normal");
         film.add_layer("depth", 1);
         film.add_layer("visibility", 1);
+        const ShadowDag* shadow_dag = shadows_ == DagShadowSource::ShadowDag ? &shadow_dags_[frame] : nullptr;
         parallel_for_tiles(w, h, settings_.tile_size, [&](const Tile& t) {
-            uint64_t tile_rays = 0;
+            uint64_t tile_rays = 0, tile_visits = 0;
+            ShadowDag::Cursor cursor;
             for (int y = t.y0; y < t.y1; ++y)
                 for (int x = t.x0; x < t.x1; ++x) {
                     const Ray r = cam.generate_ray(float(x) + 0.5f, float(y) + 0.5f);
-                    const VoxelRayHit hit = trace_voxel_ray(dag, frame, r);
+                    const VoxelRayHit hit = cast_dag_ray(frame_dag, r);
                     ++tile_rays;
+                    tile_visits += hit.nodes_visited;
                     if (!hit.hit) continue;
                     const Vec3 n = voxel_entry_normal(dag.grid(), hit.voxel, r);
                     const Vec3 p = r.at(hit.t);
-                    const LightSample ls = sample_light(shading_light, p, cam.position());
+                    const LightArrival ls = sample_light(shading_light, p, cam.position());
                     const float cos_theta = glm::dot(n, ls.wi);
                     float visibility = 0;
                     if (cos_theta > 0) {
                         visibility = 1;
-                        if (ls.needs_shadow_ray) {
+                        if (shadow_dag) {
+                            visibility = shadow_dag->visibility(p, n, 1, cursor);
+                        } else if (ls.needs_shadow_ray && shadows_ == DagShadowSource::DagRay) {
                             // From the empty voxel the primary ray came through, half a
                             // voxel off the face, so the hit voxel cannot shadow itself.
                             Ray shadow;
                             shadow.origin = p + n * (0.5f * voxel);
                             shadow.direction = ls.wi;
                             shadow.tmax = ls.distance - 0.5f * voxel;
-                            visibility = trace_voxel_ray(dag, frame, shadow).hit ? 0.0f : 1.0f;
+                            visibility = cast_dag_ray(frame_dag, shadow).hit ? 0.0f : 1.0f;
                             ++tile_rays;
                         }
                     }
@@ -173,6 +219,7 @@ void DagRaycastTechnique::render(const ViewSet& views, std::vector<Film>& films)
                     film.set("visibility", x, y, visibility);
                 }
             rays += tile_rays;
+            primary_visits += tile_visits;
         });
         film.metadata["technique"] = kName;
         film.metadata["view"] = v < views.names.size() ? views.names[v] : "mono";
@@ -181,6 +228,7 @@ void DagRaycastTechnique::render(const ViewSet& views, std::vector<Film>& films)
         film.metadata["build"] = to_string(settings_.build);
         film.metadata["resolution"] = std::to_string(settings_.resolution);
         film.metadata["light"] = shading_light ? shading_light->name : "headlight";
+        film.metadata["shadows"] = to_string(shadows_);
         film.metadata["seed"] = std::to_string(settings_.seed);
         film.metadata["git_revision"] = GILAB_GIT_REVISION;
         films[v] = std::move(film);
@@ -189,6 +237,9 @@ void DagRaycastTechnique::render(const ViewSet& views, std::vector<Film>& films)
     for (Film& film : films) film.metadata["render_time_seconds"] = format_number(ms / 1000.0);
     stats_.set("render_ms", ms);
     stats_.set("rays", double(rays.load()));
+    size_t pixels = 0;
+    for (const Film& film : films) pixels += size_t(film.width()) * size_t(film.height());
+    stats_.set("nodes_per_primary_ray", pixels ? double(primary_visits.load()) / double(pixels) : 0.0);
 }
 
 Stats DagRaycastTechnique::stats() const { return stats_; }
@@ -196,7 +247,8 @@ Stats DagRaycastTechnique::stats() const { return stats_; }
 void register_dag_raycast(TechniqueRegistry& registry) {
     registry.add({kName,
                   "ray casting through a time-correlated multi-frame DAG: one root per animation frame, voxel "
-                  "face normals, one light with shadow rays through the same frame",
+                  "face normals, one light; shadows from each frame's shadow DAG (directional and spot "
+                  "lights) or shadow rays through the same frame",
                   [] { return std::make_unique<DagRaycastTechnique>(); }});
 }
 
