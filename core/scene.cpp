@@ -1,6 +1,7 @@
 #include "core/scene.hpp"
 
 #include <cmath>
+#include <string>
 #include "core/error.hpp"
 #include "core/skin.hpp"
 
@@ -102,11 +103,13 @@ void place_skinned(const Mesh& mesh, std::span<const Mat4> joints, WorldMesh& wm
         for (UVec3& t : wm.triangles) std::swap(t.y, t.z);
 }
 
-SceneFrame flatten(const Scene& scene, const std::vector<Mat4>& world, double time) {
+// include: one flag per node, or null for every node.
+SceneFrame flatten(const Scene& scene, const std::vector<Mat4>& world, double time, const std::vector<bool>* include) {
     SceneFrame frame;
     frame.time = time;
     std::vector<std::vector<Mat4>> joints(scene.skins.size());  // per skin, computed on first use
     for (size_t i = 0; i < scene.nodes.size(); ++i) {
+        if (include && !(*include)[i]) continue;
         const SceneNode& node = scene.nodes[i];
         const bool skinned = node.skin >= 0;
         if (skinned && size_t(node.skin) >= scene.skins.size())
@@ -141,9 +144,30 @@ SceneFrame flatten(const Scene& scene, const std::vector<Mat4>& world, double ti
 
 }  // namespace
 
-SceneFrame Scene::evaluate(double time) const { return flatten(*this, node_transforms(time), time); }
+SceneFrame Scene::evaluate(double time) const { return flatten(*this, node_transforms(time), time, nullptr); }
 
-SceneFrame Scene::evaluate_rest() const { return flatten(*this, rest_node_transforms(), 0.0); }
+SceneFrame Scene::evaluate(double time, const std::vector<bool>& include_nodes) const {
+    if (include_nodes.size() != nodes.size())
+        throw Error(source.empty() ? name : source,
+                    "node selection has " + std::to_string(include_nodes.size()) + " entries but the scene has " +
+                        std::to_string(nodes.size()) + " nodes");
+    return flatten(*this, node_transforms(time), time, &include_nodes);
+}
+
+SceneFrame Scene::evaluate_rest() const { return flatten(*this, rest_node_transforms(), 0.0, nullptr); }
+
+std::vector<bool> Scene::dynamic_nodes() const {
+    // A skin does not move its node's children (they follow the node's own transform),
+    // so only animation is inherited. Parents precede children: their flag is final.
+    std::vector<bool> animated(nodes.size(), false), dynamic(nodes.size(), false);
+    for (size_t i = 0; i < nodes.size(); ++i) {
+        const SceneNode& node = nodes[i];
+        const bool animated_parent = node.parent >= 0 && size_t(node.parent) < i && animated[size_t(node.parent)];
+        animated[i] = !node.animation.empty() || animated_parent;
+        dynamic[i] = animated[i] || node.skin >= 0;
+    }
+    return dynamic;
+}
 
 void Scene::validate() const {
     const std::string where = source.empty() ? name : source;

@@ -81,6 +81,13 @@ struct Scene {
     // meshes follow its joints by linear blend skinning; the node's own transform is
     // ignored, as glTF specifies.
     SceneFrame evaluate(double time) const;
+    // Only the meshes of the nodes with include_nodes[i] set (lights: all of them; bounds:
+    // of those meshes only). An included node's world positions are bit-identical to
+    // evaluate(time)'s. Throws Error if include_nodes does not have one entry per node.
+    SceneFrame evaluate(double time, const std::vector<bool>& include_nodes) const;
+    // Per node: true when its world geometry can change with time — it or an ancestor
+    // has a non-empty animation, or it is skinned (its joints may move).
+    std::vector<bool> dynamic_nodes() const;
     SceneFrame evaluate_frame(int frame) const { return evaluate(frame / frames_per_second); }
     // Every node at its rest transform, animation ignored. For glTF skins this is
     // normally the bind pose, which their animations need not pass through.

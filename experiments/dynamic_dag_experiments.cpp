@@ -275,8 +275,12 @@ void add_table5_rows(const OpenedDynamicScene& s, const Table5Figures& f, Result
         r["RSS before (MiB)"] = mib(double(b.rss_before));
         r["peak growth (MiB)"] = mib(growth);
         r["one frame's SVO (MiB)"] = mib(double(f.max_frame_svo_bytes));
+        r["shared DAG (MiB)"] = mib(b.stats.get("table_bytes"));
         r["peak / frame SVO (×)"] = ratio(double(b.peak_rss), double(f.max_frame_svo_bytes));
         r["peak growth / frame SVO (×)"] = ratio(growth, double(f.max_frame_svo_bytes));
+        r["peak growth / (frame SVO + shared DAG) (×)"] =
+            ratio(growth, double(f.max_frame_svo_bytes) + b.stats.get("table_bytes"));
+        r["cells rebuilt"] = b.stats.has("cells_rebuilt") ? json(b.stats.get("cells_rebuilt")) : json(nullptr);
         r["per-build peak"] = b.per_build_peak;
         r["modes agree"] = f.modes_agree ? json(*f.modes_agree) : json(nullptr);
         builds.rows.push_back(r);
@@ -309,8 +313,9 @@ ExperimentOutput run_table5(const ExperimentContext& ctx) {
                    "all at once (per-frame DAGs merged together)";
     builds.columns = {"scene", "resolution (voxels/axis)", "frames", "build mode", "build (ms)", "voxelize (ms)",
                       "merge (ms)", "layout (ms)", "TC N_n (nodes)", "peak RSS (MiB)", "RSS before (MiB)",
-                      "peak growth (MiB)", "one frame's SVO (MiB)", "peak / frame SVO (×)",
-                      "peak growth / frame SVO (×)", "per-build peak", "modes agree"};
+                      "peak growth (MiB)", "one frame's SVO (MiB)", "shared DAG (MiB)", "peak / frame SVO (×)",
+                      "peak growth / frame SVO (×)", "peak growth / (frame SVO + shared DAG) (×)", "cells rebuilt",
+                      "per-build peak", "modes agree"};
 
     const auto scenes = open_dynamic_scenes(ctx, out);
     bool all_peaks = true;
@@ -370,11 +375,18 @@ ExperimentOutput run_table5(const ExperimentContext& ctx) {
         std::string(ctx.quick ? " This quick run has no 2048³ rows." : ""));
     out.notes.push_back(
         "Build: the whole of build_animation_dag (the dag_raycast technique's build), timed: a pass over the frames "
-        "for the bounds, voxelizing every frame, merging, and laying the DAG out. Incremental merges each frame into "
-        "the DAG of the frames before it and drops its voxels; all at once keeps every frame's SVDAG and merges them "
-        "level by level at the end. 'modes agree' = both builds give the same node count and the same layout words. "
-        "One frame's SVO is the largest frame's SVO as stored. Peak growth is the peak minus the RSS just before the "
-        "build, so it leaves out the loaded scene." +
+        "for the bounds (the static nodes once, the moving nodes per frame), voxelizing, merging, and laying the DAG "
+        "out. Incremental streams: the static nodes' triangles are flattened once and kept (positions and triangles "
+        "only) binned into the split cells of 32³ voxels; per frame only the moving nodes are flattened and binned, "
+        "and each frame goes into the DAG of the frames before it cell by cell, each cell voxelized from its own "
+        "triangles alone (batches of cells in parallel). Only dirty cells, those a moving triangle touches in this "
+        "frame or the one before, are voxelized again; every other cell takes the previous frame's subtree. No "
+        "whole frame's voxels or voxelizer input is ever held. 'cells rebuilt' counts the cells voxelized and merged "
+        "over all frames (every cell holding triangles in frame 0, then the dirty ones). All at once voxelizes every frame "
+        "whole, keeps every frame's SVDAG and merges them level by level at the end. 'modes agree' = both builds give "
+        "the same node count and the same layout words. One frame's SVO is the largest frame's SVO as stored; the "
+        "shared DAG is the merged DAG's node tables (hash tables included) at the end of the build, before layout. "
+        "Peak growth is the peak minus the RSS just before the build, so it leaves out the loaded scene." +
         std::string(all_peaks ? " Peak RSS is per build (VmHWM reset through /proc/self/clear_refs before each)."
                               : " Peak RSS is the process's peak so far (the per-build reset was not available)."));
     out.config = {{"resolution", resolution},
@@ -394,7 +406,7 @@ struct ImageSize {
 };
 
 struct FrameTimes {
-    double median_ms = 0, update_ms_mean = 0, render_ms_median = 0, rays_per_frame = 0;
+    double median_ms = 0, update_ms_mean = 0, render_ms_median = 0, rays_per_frame = 0, nodes_per_primary_ray = 0;
 };
 
 // Every frame in order, after one warm-up frame: update(t_k) + render, timed together.
@@ -403,7 +415,7 @@ FrameTimes time_frames(Technique& technique, const EyeCamera& camera, int frames
     technique.update(0);
     technique.render(ViewSet::mono(camera), films);
     std::vector<double> total, render;
-    double update = 0, rays = 0;
+    double update = 0, rays = 0, visits = 0;
     for (int k = 0; k < frames; ++k) {
         Stopwatch clock;
         technique.update(double(k) / fps);
@@ -413,8 +425,9 @@ FrameTimes time_frames(Technique& technique, const EyeCamera& camera, int frames
         update += st.get("update_ms");
         render.push_back(st.get("render_ms"));
         rays += st.get("rays");
+        visits += st.get("nodes_per_primary_ray");
     }
-    return {median(total), update / frames, median(render), rays / frames};
+    return {median(total), update / frames, median(render), rays / frames, visits / frames};
 }
 
 ExperimentOutput run_table6(const ExperimentContext& ctx) {
@@ -430,9 +443,10 @@ ExperimentOutput run_table6(const ExperimentContext& ctx) {
     t.title = "Table 6 — frame rate of ray casting through the multi-frame DAG along the animation";
     t.columns = {"scene", "paper scene", "image (pixels)", "stands for (pixels)", "resolution (voxels/axis)",
                  "frames", "threads", "frame median (ms)", "fps (frames/s)", "update mean (ms)",
-                 "render median (ms)", "rays per frame (rays)", "rays per second (10⁶/s)",
-                 "1 thread frame median (ms)", "1 thread fps (frames/s)", "paper CPU fps (frames/s)",
-                 "ours / paper fps (×)", "1 thread / paper fps (×)"};
+                 "render median (ms)", "shadows", "rays per frame (rays)", "rays per second (10⁶/s)",
+                 "nodes per primary ray (nodes)", "primary only fps (frames/s)", "1 thread frame median (ms)",
+                 "1 thread fps (frames/s)", "paper CPU fps (frames/s)", "ours / paper fps (×)",
+                 "1 thread / paper fps (×)", "shadow DAGs, all frames (MB)", "shadow DAG build, all frames (s)"};
     Plot plot;
     plot.title = "Frame rate through the multi-frame DAG (Table 6)";
     plot.x_label = "pixels (10³)";
@@ -443,7 +457,17 @@ ExperimentOutput run_table6(const ExperimentContext& ctx) {
         try {
             auto technique = TechniqueRegistry::builtin().create("dag_raycast");
             technique->prepare(s.scene, Settings(json{{"resolution", resolution}, {"frames", frames}}, "dag-table6"));
+            const Stats prepared = technique->stats();
+            // The paper does not say whether its frame rates include shadows: the same DAG
+            // with primary rays only is timed beside.
+            auto primary_only = TechniqueRegistry::builtin().create("dag_raycast");
+            primary_only->prepare(
+                s.scene, Settings(json{{"resolution", resolution}, {"frames", frames}, {"shadows", "none"}}, "dag-table6"));
             const SceneCamera c = s.scene.camera.value_or(default_camera_for(s.scene.evaluate(0).bounds));
+            std::vector<Film> probe;  // which shadow source the light resolved to
+            technique->render(ViewSet::mono(EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, 8, 6)),
+                              probe);
+            const std::string shadow_source = probe.at(0).metadata.at("shadows");
             ctx.say(s.name + ": DAG built, " + std::to_string(frames) + " frames × " + std::to_string(sizes.size()) +
                     " image sizes");
             PlotSeries ours{s.name, {}, {}, false, true, color}, paper{"paper " + s.paper_scene, {}, {}, true, true, color};
@@ -452,6 +476,7 @@ ExperimentOutput run_table6(const ExperimentContext& ctx) {
                 const EyeCamera camera =
                     EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, size.width, size.height);
                 const FrameTimes all = time_frames(*technique, camera, frames, s.scene.frames_per_second);
+                const FrameTimes primary = time_frames(*primary_only, camera, frames, s.scene.frames_per_second);
                 FrameTimes one;
                 {
                     ThreadLimit single(1);
@@ -472,14 +497,22 @@ ExperimentOutput run_table6(const ExperimentContext& ctx) {
                 row["fps (frames/s)"] = fps;
                 row["update mean (ms)"] = all.update_ms_mean;
                 row["render median (ms)"] = all.render_ms_median;
+                row["shadows"] = shadow_source;
                 row["rays per frame (rays)"] = all.rays_per_frame;
                 row["rays per second (10⁶/s)"] =
                     all.render_ms_median > 0 ? json(all.rays_per_frame / all.render_ms_median / 1e3) : json(nullptr);
+                row["nodes per primary ray (nodes)"] = all.nodes_per_primary_ray;
+                row["primary only fps (frames/s)"] = primary.median_ms > 0 ? 1000.0 / primary.median_ms : 0.0;
                 row["1 thread frame median (ms)"] = one.median_ms;
                 row["1 thread fps (frames/s)"] = fps1;
                 row["paper CPU fps (frames/s)"] = paper_fps;
                 row["ours / paper fps (×)"] = fps / paper_fps;
                 row["1 thread / paper fps (×)"] = fps1 / paper_fps;
+                const bool has_shadow_dags = prepared.has("shadow_dag_bytes");
+                row["shadow DAGs, all frames (MB)"] =
+                    has_shadow_dags ? json(mb(prepared.get("shadow_dag_bytes"))) : json(nullptr);
+                row["shadow DAG build, all frames (s)"] =
+                    has_shadow_dags ? json(prepared.get("shadow_dag_build_ms") / 1000.0) : json(nullptr);
                 t.rows.push_back(row);
                 const double kilo_pixels = double(size.width) * size.height / 1e3;
                 ours.x.push_back(kilo_pixels);
@@ -510,11 +543,15 @@ ExperimentOutput run_table6(const ExperimentContext& ctx) {
     out.notes.push_back(
         "Renderer: the dag_raycast technique, prepared once per scene (incremental build of the multi-frame DAG at the "
         "resolution shown over the frames shown). Per frame: update(t_k), which only selects frame k's root, then one "
-        "primary ray per pixel from the scene camera through that root, the hit shaded with the voxel face normal and "
-        "the scene's first point or directional light, and a shadow ray through the same frame's DAG for surfaces "
-        "facing the light. Each image size renders every frame in order after one warm-up frame; a frame's time is "
-        "update + render, and fps = 1000 / the median frame time. The same is repeated at 1 thread (ThreadLimit). "
-        "frame_<scene>.png: frame F/2 at the largest size.");
+        "primary ray per pixel from the scene camera through that root (single-precision octree walk after Laine & "
+        "Karras 2010), the hit shaded with the voxel face normal and the scene's first point, spot or directional "
+        "light. Shadows (column 'shadows'): shadow_dag = a lookup in that frame's shadow DAG (P2 §3; one per frame, "
+        "built at prepare at the voxel resolution from the frame's triangles, so it is not part of the frame time); "
+        "dag_ray = a shadow ray through the same frame's DAG, for point lights, which the shadow DAG's light space "
+        "does not cover. Each image size renders every frame in order after one warm-up frame; a frame's time is "
+        "update + render, and fps = 1000 / the median frame time. The same is repeated at 1 thread (ThreadLimit), "
+        "and with shadows off ('primary only', all threads), since the paper does not say whether its figures "
+        "include shadows. frame_<scene>.png: frame F/2 at the largest size.");
     out.notes.push_back(
         "The paper's figures are CPU-only frame rates on its own machine and scenes (Kitchen and Robot from "
         "Chalmers); ours run on this machine's " + std::to_string(default_thread_count()) +

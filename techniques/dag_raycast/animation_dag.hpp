@@ -1,9 +1,11 @@
 #pragma once
 // Every frame of a scene's animation voxelized on one shared grid and merged into one
-// time-correlated multi-frame DAG (P2 §4), then laid out for ray casting. Frames are
-// voxelized one at a time; the incremental build merges each into the DAG of the frames
-// before it and drops its voxels (the streaming mode (b)), the all-at-once build keeps
-// every frame's SVDAG and merges them together at the end (mode (a)).
+// time-correlated multi-frame DAG (P2 §4), then laid out for ray casting. The incremental
+// build (the streaming mode (b)) hands each frame to the DAG one split cell at a time
+// (SequenceVoxelizer): static triangles are kept once, and only the cells a moving
+// triangle touches in this frame or the one before are voxelized again, so its peak is
+// about the shared DAG plus one batch of cells. The all-at-once build (mode (a))
+// voxelizes whole frames, keeps every frame's SVDAG and merges them together at the end.
 #include <vector>
 #include "accel/temporal_svdag.hpp"
 #include "core/light.hpp"
@@ -25,8 +27,11 @@ struct AnimationDag {
     std::vector<double> times;                       // scene time of each frame
     std::vector<std::vector<PunctualLight>> lights;  // world-space lights of each frame
     // build_ms (all of it: the bounds pass, voxelizing, merging, laying out),
-    // voxelize_ms, merge_ms, layout_ms, voxels_per_frame (mean), voxel_size,
-    // peak_rss_mib (of the process).
+    // voxelize_ms (incremental: binning and every cell's voxels), merge_ms, layout_ms,
+    // voxels_per_frame (mean), voxel_size, table_bytes (the merged DAG's node tables
+    // before layout), peak_rss_mib (of the process); incremental only: cells_rebuilt
+    // (cells voxelized and merged again, over all frames) and cells_reused (clean cells
+    // that took the previous frame's subtree).
     Stats stats;
 };
 
