@@ -52,8 +52,9 @@ VoxelRayHit cast_dag_ray(const DagWordsView& dag, const Ray& ray) {
     // so ray parameters are unchanged; it is done in double so that large scenes keep
     // their precision up to the final rounding.
     const double cube = dag.grid.voxel_size() * std::ldexp(1.0, dag.depth);
-    const DVec3 origin = 1.0 + (DVec3(ray.origin) - DVec3(dag.grid.origin)) / cube;
-    const DVec3 direction = DVec3(ray.direction) / cube;
+    const double inv_cube = 1.0 / cube;
+    const DVec3 origin = 1.0 + (DVec3(ray.origin) - DVec3(dag.grid.origin)) * inv_cube;
+    const DVec3 direction = DVec3(ray.direction) * inv_cube;
     const float min_component = std::ldexp(1.0f, -kMaxScale);
 
     // t on axis k at coordinate x is x·coef[k] − bias[k]. Axes with a positive direction
@@ -120,19 +121,22 @@ VoxelRayHit cast_dag_ray(const DagWordsView& dag, const Ray& ray) {
                 parent = words[parent + 1 + child_rank(mask, int(slot))];
                 mask = words[parent] & 0xffu;
                 const float half = scale_exp2 * 0.5f;
-                idx = 0;
                 --scale;
                 scale_exp2 = half;
-                for (int k = 0; k < 3; ++k)
-                    if (half * coef[k] + tc[k] > t_min) idx ^= 1u << k, pos[k] += half;
+                // Branch-free: the half the ray enters on each axis (these branches would
+                // be mispredicted about half the time).
+                const uint32_t upper[3] = {half * coef[0] + tc[0] > t_min, half * coef[1] + tc[1] > t_min,
+                                           half * coef[2] + tc[2] > t_min};
+                idx = upper[0] | upper[1] << 1 | upper[2] << 2;
+                for (int k = 0; k < 3; ++k) pos[k] += upper[k] ? half : 0.0f;
                 t_max = tv_max;
                 continue;
             }
         }
         // Advance to the neighbour the ray enters next.
-        uint32_t step = 0;
-        for (int k = 0; k < 3; ++k)
-            if (tc[k] <= tc_max) step ^= 1u << k, pos[k] -= scale_exp2;
+        const uint32_t crossed[3] = {tc[0] <= tc_max, tc[1] <= tc_max, tc[2] <= tc_max};
+        const uint32_t step = crossed[0] | crossed[1] << 1 | crossed[2] << 2;
+        for (int k = 0; k < 3; ++k) pos[k] -= crossed[k] ? scale_exp2 : 0.0f;
         t_min = tc_max;
         idx ^= step;
         if (t_min > ray.tmax) break;
@@ -141,7 +145,7 @@ VoxelRayHit cast_dag_ray(const DagWordsView& dag, const Ray& ray) {
             // positions differ names the level of the common ancestor.
             uint32_t differing = 0;
             for (int k = 0; k < 3; ++k)
-                if ((step >> k) & 1u) differing |= bits_of(pos[k]) ^ bits_of(pos[k] + scale_exp2);
+                differing |= (bits_of(pos[k]) ^ bits_of(pos[k] + scale_exp2)) & (0u - crossed[k]);
             scale = int(bits_of(float(differing)) >> 23) - 127;
             if (scale >= kMaxScale) break;  // left the root
             scale_exp2 = float_of(uint32_t(scale - kMaxScale + 127) << 23);

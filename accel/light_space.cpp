@@ -18,7 +18,24 @@ std::string light_label(const PunctualLight& light) {
     return "light '" + (light.name.empty() ? std::string("(unnamed)") : light.name) + "'";
 }
 
+// Greatest depth of the box's corners along a spot light's axis.
+double farthest_axial_depth(const PunctualLight& light, const Bounds3& bounds) {
+    const Vec3 dir = glm::normalize(light.direction);
+    double zmax = -1e300;
+    for (int i = 0; i < 8; ++i) {
+        const Vec3 c(i & 1 ? bounds.max.x : bounds.min.x, i & 2 ? bounds.max.y : bounds.min.y,
+                     i & 4 ? bounds.max.z : bounds.min.z);
+        zmax = std::max(zmax, double(glm::dot(c - light.position, dir)));
+    }
+    return zmax;
+}
+
 }  // namespace
+
+bool LightSpace::faces_any_of(const PunctualLight& light, const Bounds3& bounds) {
+    if (light.type != LightType::Spot) return true;
+    return !bounds.empty() && glm::length(light.direction) > 0 && farthest_axial_depth(light, bounds) > 0;
+}
 
 LightSpace::LightSpace(const PunctualLight& light, const Bounds3& bounds, uint32_t resolution) : n_(resolution) {
     const std::string where = "shadow light space (" + light_label(light) + ")";

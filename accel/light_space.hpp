@@ -7,7 +7,7 @@
 //  * Spot light: its perspective frustum. u, v are the projected position over the
 //    cone's square of tangents; w is axial depth (distance along the spot axis),
 //    linear between near and far planes fitted to the scene bounds.
-//  * Point light: refused (a cube of six spot frusta is not built).
+//  * Point light: refused; LightShadowDags covers one with a cube of six spot frusta.
 // Resolution N is any value from 8 to 2^17; the octrees over the grid have depth
 // ceil(log2 N) and the columns or layers beyond N hold no geometry.
 #include <cstdint>
@@ -24,6 +24,10 @@ public:
     // Throws Error naming the light for a point light, a spot cone of 80° half-angle or
     // more, a zero direction, an empty or non-finite scene box, or a bad resolution.
     LightSpace(const PunctualLight& light, const Bounds3& scene_bounds, uint32_t resolution);
+    // Whether any of the box can lie in the light's view volume: always for a directional
+    // light, for a spot light some of the box is in front of it (the constructor refuses
+    // the rest).
+    static bool faces_any_of(const PunctualLight& light, const Bounds3& scene_bounds);
 
     uint32_t resolution() const { return n_; }
     int depth() const { return depth_; }                 // octree depth, ceil(log2 N)

@@ -178,15 +178,10 @@ ShadowDag ShadowDag::build(int grid_depth, const TileFill& fill, const ShadowDag
 ShadowDag ShadowDag::build(const Scene& scene, const RayTracer& tracer, const PunctualLight& light,
                            const ShadowDagOptions& options) {
     const LightSpace space(light, tracer.frame().bounds, options.resolution);
-    {
-        // A coarse look first, so a light that sees nothing is refused at once.
-        const LightSpace probe(light, tracer.frame().bounds, kProbeResolution);
-        LightDepthTile t;
-        t.render(tracer, probe, nullptr, 0, 0, kProbeResolution);
-        if (!t.any_hit())
-            throw Error("shadow DAG (light '" + light.name + "')",
-                        "the light sees no geometry in its view volume (probed at 512² rays)");
-    }
+    // A coarse look first, so a light that sees nothing is refused at once.
+    if (!light_sees_geometry(tracer, light))
+        throw Error("shadow DAG (light '" + light.name + "')",
+                    "the light sees no geometry in its view volume (probed at 512² rays)");
     Stopwatch closed_clock;
     const ClosedSurfaces closed = options.double_depth ? closed_surfaces(scene, tracer.frame()) : ClosedSurfaces{};
     const double closed_ms = closed_clock.elapsed_ms();
@@ -198,6 +193,14 @@ ShadowDag ShadowDag::build(const Scene& scene, const RayTracer& tracer, const Pu
     dag.stats_.total_ms += closed_ms;
     dag.space_ = space;
     return dag;
+}
+
+bool ShadowDag::light_sees_geometry(const RayTracer& tracer, const PunctualLight& light) {
+    if (!LightSpace::faces_any_of(light, tracer.frame().bounds)) return false;
+    const LightSpace probe(light, tracer.frame().bounds, kProbeResolution);
+    LightDepthTile t;
+    t.render(tracer, probe, nullptr, 0, 0, kProbeResolution);
+    return t.any_hit();
 }
 
 size_t ShadowDag::node_count() const {

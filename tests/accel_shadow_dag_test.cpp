@@ -5,6 +5,7 @@
 #include <functional>
 #include <random>
 #include "accel/dag_layout.hpp"
+#include "accel/light_shadow_dags.hpp"
 #include "accel/shadow_dag.hpp"
 #include "accel/shadow_map.hpp"
 #include "core/camera.hpp"
@@ -266,6 +267,7 @@ Scene shadow_test_scene(bool closed_boxes, LightType light_type) {
     l.name = "sun";
     l.type = light_type;
     l.direction = glm::normalize(Vec3(-0.8f, -1, -0.6f));  // low sun: long shadows
+    if (light_type == LightType::Point) l.position = Vec3(0.2f, 2.0f, 0.6f);  // between the boxes, above
     if (light_type == LightType::Spot) {
         l.position = Vec3(3, 7, 2.5f);
         l.direction = glm::normalize(Vec3(0) - l.position);
@@ -395,6 +397,47 @@ void expect_matches_rays(LightType type, bool closed_boxes, bool double_depth) {
 TEST(ShadowDag, DirectionalLightMatchesShadowRaysUpToOneVoxelOfABoundary) {
     expect_matches_rays(LightType::Directional, true, false);
     expect_matches_rays(LightType::Directional, true, true);
+}
+
+// A point light low between the boxes casts shadows in several directions: the cube of six
+// spot-frustum DAGs answers like shadow rays, seams included, except within a voxel of a
+// shadow boundary; faces that see nothing hold no DAG.
+TEST(ShadowDag, PointLightCubeMatchesShadowRaysUpToOneVoxelOfABoundary) {
+    const Scene scene = shadow_test_scene(true, LightType::Point);
+    const SceneFrame frame = scene.evaluate(0);
+    const RayTracer tracer(frame);
+    const PunctualLight& light = frame.lights[0];
+    ShadowDagOptions o;
+    o.resolution = 256;
+    const LightShadowDags dags = LightShadowDags::build(scene, tracer, light, o);
+    ASSERT_TRUE(dags.cube());
+    EXPECT_FALSE(dags.dag(2).has_value()) << "nothing lies above the light (+y)";
+    EXPECT_TRUE(dags.dag(3).has_value());
+    EXPECT_EQ(dags.dag_count(), 5u);
+    std::vector<Surface> pts = visible_points(tracer, 4000);
+    ASSERT_GT(pts.size(), 3000u);
+    int mismatches = 0, shadowed = 0;
+    LightShadowDags::Cursor cursor;
+    for (const Surface& s : pts) {
+        const bool truth = ray_lit(tracer, s.p, s.n, light);
+        shadowed += !truth;
+        if ((dags.visibility(s.p, s.n, 1, cursor) > 0.5f) != truth) {
+            ++mismatches;
+            const Vec3 r = glm::abs(s.p - light.position);
+            const int axis = r.x >= r.y && r.x >= r.z ? 0 : (r.y >= r.z ? 1 : 2);
+            const int face = 2 * axis + ((s.p - light.position)[axis] < 0 ? 1 : 0);
+            ASSERT_TRUE(dags.dag(face).has_value());
+            EXPECT_TRUE(within_one_voxel_of_a_boundary(tracer, *dags.dag(face)->space(), s,
+                                                       LightShadowDags::cube_face(light, face)))
+                << "mismatch more than a voxel from any shadow boundary at " << s.p.x << "," << s.p.y << "," << s.p.z;
+        }
+    }
+    EXPECT_GT(shadowed, 100);
+    EXPECT_LT(mismatches, int(pts.size()) / 50);
+    const PunctualLight face = LightShadowDags::cube_face(light, 5);
+    EXPECT_EQ(face.type, LightType::Spot);
+    EXPECT_EQ(face.direction, Vec3(0, 0, -1));
+    EXPECT_EQ(face.position, light.position);
 }
 
 TEST(ShadowDag, SpotLightMatchesShadowRaysUpToOneVoxelOfABoundary) {

@@ -7,9 +7,9 @@
 // shows the scene at k / fps), build (incremental | all_at_once: how the frames are merged,
 // P2 §4 (b) / (a)), light (-1: the scene's first point or directional light, else its
 // index), ambient (0.05: unshadowed light as a fraction of the light's irradiance),
-// shadows (auto | shadow_dag | dag_ray | none: auto takes the shadow DAG for directional
-// and spot lights, whose light space it is defined over, and shadow rays through the
-// frame's DAG for point lights), shadow_resolution (0: the voxel resolution; voxels per
+// shadows (auto = shadow_dag | dag_ray | none: shadow_dag looks up the frame's shadow
+// DAGs, one over a directional or spot light's light space or a cube of six for a point
+// light; dag_ray casts a shadow ray through the frame's DAG), shadow_resolution (0: the voxel resolution; voxels per
 // axis of each frame's shadow DAG), tile_size (16: image tile), seed (recorded only: nothing is random), spp (only 1: one
 // primary ray per pixel).
 #include <cstdint>
@@ -22,8 +22,8 @@ const char* to_string(DagBuildMode mode);
 
 // Where a lit surface's visibility comes from.
 enum class DagShadowSource {
-    Auto,       // ShadowDag for directional and spot lights, DagRay for point lights
-    ShadowDag,  // the shadow DAG of the frame (P2 §3), built at prepare
+    Auto,       // ShadowDag
+    ShadowDag,  // the frame's shadow DAGs (P2 §3; six for a point light), built at prepare
     DagRay,     // a shadow ray through the frame's own multi-frame DAG root
     None,       // every surface facing the light is lit
 };

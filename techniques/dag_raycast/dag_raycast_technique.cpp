@@ -108,38 +108,34 @@ void DagRaycastTechnique::prepare(const Scene& scene, const Settings& settings) 
     stats_.set("pointers", double(dag.pointer_count()));
     stats_.set("bytes_32bit", double(dag.bytes()));
     stats_.set("frame", 0);
-    prepare_shadows(scene, where);
+    prepare_shadows(scene);
     stats_.set("prepare_ms", watch.elapsed_ms());
 }
 
-void DagRaycastTechnique::prepare_shadows(const Scene& scene, const std::string& where) {
+void DagRaycastTechnique::prepare_shadows(const Scene& scene) {
     shadow_dags_.clear();
     const PunctualLight* l = light();
-    const bool has_light_space = l && (l->type == LightType::Directional || l->type == LightType::Spot);
-    shadows_ = settings_.shadows;
-    if (shadows_ == DagShadowSource::Auto)
-        shadows_ = !l ? DagShadowSource::None : has_light_space ? DagShadowSource::ShadowDag : DagShadowSource::DagRay;
-    if (shadows_ == DagShadowSource::ShadowDag && !has_light_space)
-        throw Error("dag_raycast.shadows", std::string("the shadow DAG needs a directional or spot light, and the "
-                                                       "shading light of ") +
-                                               where + " is " + (l ? std::string("a point light") : "the headlight"));
-    if (shadows_ == DagShadowSource::DagRay && !l) shadows_ = DagShadowSource::None;  // nothing can shadow it
+    shadows_ = settings_.shadows == DagShadowSource::Auto ? DagShadowSource::ShadowDag : settings_.shadows;
+    // The headlight sits at the eye: nothing it lights can be shadowed.
+    if (!l) shadows_ = DagShadowSource::None;
     if (shadows_ != DagShadowSource::ShadowDag) return;
 
-    // One shadow DAG per frame over that frame's geometry and light, as the frames'
-    // voxels were: the renderer then only looks up the frame's DAG.
+    // Shadow DAGs per frame over that frame's geometry and light, as the frames' voxels
+    // were: the renderer then only looks up the frame's DAGs.
     Stopwatch watch;
     ShadowDagOptions o;
     o.resolution = settings_.shadow_resolution ? settings_.shadow_resolution : settings_.resolution;
     TracedScene traced;
     traced.load(scene);
-    size_t bytes = 0;
+    size_t bytes = 0, dags = 0;
     for (size_t k = 0; k < animation_.times.size(); ++k) {
         traced.set_time(animation_.times[k]);
         shadow_dags_.push_back(
-            ShadowDag::build(scene, traced.tracer(), animation_.lights[k][size_t(light_index_)], o));
+            LightShadowDags::build(scene, traced.tracer(), animation_.lights[k][size_t(light_index_)], o));
         bytes += shadow_dags_.back().bytes();
+        dags += shadow_dags_.back().dag_count();
     }
+    stats_.set("shadow_dags", double(dags));
     stats_.set("shadow_dag_resolution", double(o.resolution));
     stats_.set("shadow_dag_build_ms", watch.elapsed_ms());
     stats_.set("shadow_dag_bytes", double(bytes));
@@ -180,10 +176,10 @@ void DagRaycastTechnique::render(const ViewSet& views, std::vector<Film>& films)
         film.add_layer("normal");
         film.add_layer("depth", 1);
         film.add_layer("visibility", 1);
-        const ShadowDag* shadow_dag = shadows_ == DagShadowSource::ShadowDag ? &shadow_dags_[frame] : nullptr;
+        const LightShadowDags* shadow_dag = shadows_ == DagShadowSource::ShadowDag ? &shadow_dags_[frame] : nullptr;
         parallel_for_tiles(w, h, settings_.tile_size, [&](const Tile& t) {
             uint64_t tile_rays = 0, tile_visits = 0;
-            ShadowDag::Cursor cursor;
+            LightShadowDags::Cursor cursor;
             for (int y = t.y0; y < t.y1; ++y)
                 for (int x = t.x0; x < t.x1; ++x) {
                     const Ray r = cam.generate_ray(float(x) + 0.5f, float(y) + 0.5f);
@@ -247,8 +243,8 @@ Stats DagRaycastTechnique::stats() const { return stats_; }
 void register_dag_raycast(TechniqueRegistry& registry) {
     registry.add({kName,
                   "ray casting through a time-correlated multi-frame DAG: one root per animation frame, voxel "
-                  "face normals, one light; shadows from each frame's shadow DAG (directional and spot "
-                  "lights) or shadow rays through the same frame",
+                  "face normals, one light; shadows from each frame's shadow DAGs (a cube of six for a point "
+                  "light) or shadow rays through the same frame",
                   [] { return std::make_unique<DagRaycastTechnique>(); }});
 }
 

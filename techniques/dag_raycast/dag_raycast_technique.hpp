@@ -4,10 +4,10 @@
 // update(t) only selects the root of the nearest frame (nothing is rebuilt per frame,
 // which is the point of the structure); render casts one primary ray per pixel through
 // that root, shades the hit with the entered voxel face's normal and one light (N·L plus
-// a small ambient term). Visibility comes from the frame's shadow DAG (P2 §3; built for
-// every frame at prepare, for directional and spot lights) or from a shadow ray through
-// the same frame's DAG (point lights, whose all-round light space the shadow DAG does
-// not cover), as the `shadows` setting chooses.
+// a small ambient term). Visibility comes from the frame's shadow DAGs (P2 §3; built for
+// every frame at prepare: one over a directional or spot light's light space, a cube of
+// six for a point light) or from a shadow ray through the same frame's DAG, as the
+// `shadows` setting chooses.
 //
 // Settings: see dag_raycast_settings.hpp. Layers: color (grey Lambertian voxels: the
 // voxels carry no material), normal (the face normal; 0 for background), depth (distance
@@ -16,7 +16,7 @@
 // Without a point, spot or directional light, a headlight at the eye stands in.
 #include <string>
 #include <vector>
-#include "accel/shadow_dag.hpp"
+#include "accel/light_shadow_dags.hpp"
 #include "core/light.hpp"
 #include "techniques/dag_raycast/animation_dag.hpp"
 #include "techniques/dag_raycast/dag_raycast_settings.hpp"
@@ -44,7 +44,7 @@ private:
     // The shading light of the current frame, or nullptr for the headlight.
     const PunctualLight* light() const;
     // Resolves `shadows` for the chosen light; builds every frame's shadow DAG if needed.
-    void prepare_shadows(const Scene& scene, const std::string& where);
+    void prepare_shadows(const Scene& scene);
 
     DagRaycastSettings settings_;
     AnimationDag animation_;
@@ -52,7 +52,7 @@ private:
     int light_index_ = -1;  // into each frame's lights; -1 = headlight
     size_t frame_ = 0;
     DagShadowSource shadows_ = DagShadowSource::None;  // resolved: never Auto
-    std::vector<ShadowDag> shadow_dags_;               // one per frame with ShadowDag
+    std::vector<LightShadowDags> shadow_dags_;         // one set per frame with ShadowDag
     Stats stats_;
 };
 
