@@ -173,9 +173,11 @@ void DagRaycastTechnique::render(const ViewSet& views, std::vector<Film>& films)
         const int w = cam.width(), h = cam.height();
         check_resolution(w, h, 4);
         Film film(w, h);
-        film.add_layer("normal");
-        film.add_layer("depth", 1);
-        film.add_layer("visibility", 1);
+        // Layers looked up once, not per pixel.
+        float* color = film.layer("color").data.data();
+        float* normal = film.add_layer("normal").data.data();
+        float* depth = film.add_layer("depth", 1).data.data();
+        float* visible = film.add_layer("visibility", 1).data.data();
         const LightShadowDags* shadow_dag = shadows_ == DagShadowSource::ShadowDag ? &shadow_dags_[frame] : nullptr;
         parallel_for_tiles(w, h, settings_.tile_size, [&](const Tile& t) {
             uint64_t tile_rays = 0, tile_visits = 0;
@@ -209,10 +211,13 @@ void DagRaycastTechnique::render(const ViewSet& views, std::vector<Film>& films)
                     }
                     const Vec3 c = (kAlbedo * kInvPi) * ls.irradiance *
                                    (ambient_scale + Vec3(std::max(0.0f, cos_theta) * visibility));
-                    film.set("color", x, y, c);
-                    film.set("normal", x, y, n);
-                    film.set("depth", x, y, hit.t * glm::length(r.direction));
-                    film.set("visibility", x, y, visibility);
+                    const size_t pixel = size_t(y) * size_t(w) + size_t(x);
+                    for (int k = 0; k < 3; ++k) {
+                        color[3 * pixel + size_t(k)] = c[k];
+                        normal[3 * pixel + size_t(k)] = n[k];
+                    }
+                    depth[pixel] = hit.t * glm::length(r.direction);
+                    visible[pixel] = visibility;
                 }
             rays += tile_rays;
             primary_visits += tile_visits;
