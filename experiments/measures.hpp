@@ -1,7 +1,7 @@
 #pragma once
-// Small helpers the DAG experiments share to turn measurements into table cells: sizes
+// Small helpers the experiments share to turn measurements into table cells: sizes
 // in MB (10⁶ B) and MiB (2²⁰ B), ratios that stay empty when the divisor is zero, the
-// median of repeated timings, and the machine's load while timing.
+// median and mean of repeated timings, and the machine's load while timing.
 #include <algorithm>
 #include <fstream>
 #include <vector>
@@ -19,6 +19,12 @@ inline double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     const size_t n = v.size();
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+inline double mean(const std::vector<double>& v) {
+    double sum = 0;
+    for (double x : v) sum += x;
+    return v.empty() ? 0 : sum / double(v.size());
 }
 
 // 1-minute load average (−1 if unknown): other work on a shared machine slows timings,

@@ -22,6 +22,7 @@
 #include "core/stats.hpp"
 #include "core/voxelizer.hpp"
 #include "experiments/experiment.hpp"
+#include "experiments/measures.hpp"
 #include "scenes/builtin_scenes.hpp"
 #include "scenes/scene_library.hpp"
 #include "techniques/technique.hpp"
@@ -33,17 +34,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-double median(std::vector<double> v) {
-    if (v.empty()) return 0;
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-}
-double mean(const std::vector<double>& v) {
-    double s = 0;
-    for (double x : v) s += x;
-    return v.empty() ? 0 : s / double(v.size());
-}
-constexpr double kMiB = 1024.0 * 1024.0;
 
 // ---------------------------------------------------------------------------------
 // Scenes
@@ -300,7 +290,7 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, bool dynamic_scen
     const PaperTable& paper = dynamic_scenes ? paper_dynamic() : paper_static();
     const int table = (figure == Figure::Count ? 1 : figure == Figure::Time ? 3 : 5) + (dynamic_scenes ? 1 : 0);
     ResultTable t;
-    const char* what[] = {"voxel counts (×10⁶)", "voxelization time (ms)", "memory (MB, opacity only)"};
+    const char* what[] = {"voxel counts (×10⁶)", "voxelization time (ms)", "memory (MB = 10⁶ B, opacity only)"};
     t.title = "Table " + std::to_string(table) + " — " + what[int(figure)] + ", " +
               (dynamic_scenes ? "Sponza" : "Cornell box + Stanford models");
     switch (figure) {
@@ -311,7 +301,7 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, bool dynamic_scen
             t.columns = {"scene", "resolution", "structure", "voxelize_ms", "paper voxelize_ms"};
             break;
         case Figure::Memory:
-            t.columns = {"scene", "resolution", "structure", "opacity_MB", "stored_MB", "paper opacity_MB"};
+            t.columns = {"scene", "resolution", "structure", "opacity (MB)", "stored (MB)", "paper opacity (MiB, printed as MB)"};
             break;
     }
     for (const SceneFigures& sf : figures) {
@@ -337,9 +327,9 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, bool dynamic_scen
                     r["paper voxelize_ms"] = p ? nlohmann::json(p->ms) : nlohmann::json();
                     break;
                 case Figure::Memory:
-                    r["opacity_MB"] = f.opacity_bytes / kMiB;
-                    r["stored_MB"] = f.structure_bytes / kMiB;
-                    r["paper opacity_MB"] = p ? nlohmann::json(p->mb) : nlohmann::json();
+                    r["opacity (MB)"] = mb(f.opacity_bytes);
+                    r["stored (MB)"] = mb(f.structure_bytes);
+                    r["paper opacity (MiB, printed as MB)"] = p ? nlohmann::json(p->mb) : nlohmann::json();
                     break;
             }
             t.rows.push_back(r);
@@ -381,7 +371,8 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, bool dynamic_scen
     out.notes.push_back(
         "Memory (opacity only, 1 byte per voxel as the paper counts, per face for the anisotropic cascades): 3D "
         "texture = resolution³ B; SVO / SVDAG / MSVO = one byte per node; OpenVDB = one byte per active voxel; "
-        "cascaded = levels × 32³ × 6 B. stored_MB is what each implementation really holds (pointers, trees, and "
+        "cascaded = levels × 32³ × 6 B. The paper's MB are 2²⁰ B (its 3D texture at 128³, 2 097 152 B, is printed as 2 MB), "
+        "ours 10⁶ B. 'stored' is what each implementation really holds (pointers, trees, and "
         "for the cascades every G-buffer attribute and both radiance buffers as floats).");
     if (dynamic_scenes)
         out.notes.push_back("Sibenik Cathedral is not available (not in the shared scene set): only Sponza (Dabrovic's "
@@ -505,15 +496,14 @@ ExperimentOutput run_table7(const ExperimentContext& ctx) {
                   {"cascade", "6 levels × 32³, finest voxel = the dense voxel"},
                   {"frames", frames},
                   {"statistic", "median over frames"},
-                  {"structure_MB", {{"dense", bytes[0] / kMiB}, {"cascaded", bytes[1] / kMiB}}}};
+                  {"structure_MB", {{"dense", mb(bytes[0])}, {"cascaded", mb(bytes[1])}}}};
     out.notes.push_back("primary = Embree primary rays (the paper rasterizes: ~1 ms on its GPU); update = voxel "
                         "update (dense: the whole grid re-voxelized every frame, as VXGI does for dynamic scenes — the "
                         "paper's 15.5 ms; cascaded: scheduled scrolling and border voxelization — the paper's 2.0 ms); "
                         "injection = direct light into the voxels + anisotropic filtering + the voxel bounce (16 cones "
                         "per voxel face); direct = ray-traced direct light at the pixels; diffuse = 16 cones per pixel; "
                         "specular = one cone per glossy pixel. The paper's total excludes the update; ours includes it.");
-    out.notes.push_back("CPU (all threads) vs the paper's GPU: compare the cascaded/dense ratios, not milliseconds. "
-                        "Target: cascaded total ≤ 0.75 × dense.");
+    out.notes.push_back("CPU (all threads) vs the paper's GPU: compare the cascaded/dense ratios, not milliseconds.");
     return out;
 }
 
@@ -612,7 +602,6 @@ ExperimentOutput run_fig9(const ExperimentContext& ctx) {
                   {"image", ctx.quick ? "32²" : "192²"}};
     out.notes.push_back("frame_ms = update + injection + primary + direct + diffuse + specular for one render() on the "
                         "CPU. LPV and photon mapping (the paper's other two curves) are not part of this comparison.");
-    out.notes.push_back("Target: the update strategy cuts the per-frame update time ≥ 5× (row 'everything ÷ strategy').");
     return out;
 }
 
@@ -621,21 +610,21 @@ ExperimentOutput run_fig10(const ExperimentContext& ctx) {
     quick_note(ctx, out);
     const auto& runs = path_runs(ctx);
     ResultTable t;
-    t.title = "Fig. 10 — memory along the camera path (MB of voxel structures; process RSS)";
+    t.title = "Fig. 10 — memory along the camera path (MB = 10⁶ B, of voxel structures; process RSS)";
     t.columns = {"frame"};
-    for (const PathRun& r : runs) t.columns.push_back(r.name + " MB");
-    t.columns.push_back("process RSS MB");
+    for (const PathRun& r : runs) t.columns.push_back(r.name + " (MB)");
+    t.columns.push_back("process RSS (MB)");
     for (size_t f = 0; f < runs[0].bytes.size(); ++f) {
         nlohmann::json row = {{"frame", f + 1}};
-        for (const PathRun& r : runs) row[r.name + " MB"] = r.bytes[f] / kMiB;
-        row["process RSS MB"] = runs.back().rss[f] / kMiB;
+        for (const PathRun& r : runs) row[r.name + " (MB)"] = mb(r.bytes[f]);
+        row["process RSS (MB)"] = mb(runs.back().rss[f]);
         t.rows.push_back(row);
     }
     ResultTable summary;
     summary.title = "Fig. 10 summary — mean structure memory, cascaded ÷ dense";
-    summary.columns = {"variant", "MB", "over_dense", "paper over_dense"};
+    summary.columns = {"variant", "mean structure (MB)", "over_dense", "paper over_dense"};
     for (const PathRun& r : runs)
-        summary.rows.push_back({{"variant", r.name}, {"MB", mean(r.bytes) / kMiB}, {"over_dense", mean(r.bytes) / mean(runs[0].bytes)},
+        summary.rows.push_back({{"variant", r.name}, {"mean structure (MB)", mb(mean(r.bytes))}, {"over_dense", mean(r.bytes) / mean(runs[0].bytes)},
                                 {"paper over_dense", r.name == "dense mip" ? 1.0 : 0.4}});
     out.tables.push_back(t);
     out.tables.push_back(summary);

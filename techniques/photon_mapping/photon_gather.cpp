@@ -72,6 +72,11 @@ PhotonGatherer::PhotonGatherer(const PhotonMap& map, const std::vector<Material>
     nano_ = dynamic_cast<const NanoflannPhotonMap*>(&map);
     if (grid_ && !grid_->empty() && grid_->radius() != radius)
         throw Error("photon gather", "the hash grid was built for another radius; build it again");
+    // A query radius no larger than a cell meets at most the 3×3×3 cells around the
+    // point, which is what estimate() has room for.
+    if (grid_ && !grid_->empty() && !(grid_->cell_size() >= radius))
+        throw Error("photon gather", "the hash grid's cells (" + std::to_string(grid_->cell_size()) +
+                                         ") are smaller than the gather radius (" + std::to_string(radius) + ")");
     if (!grid_) {  // the trees' sort keys use r-sized cells from the photons' minimum
         Bounds3 box;
         for (uint32_t i = 0; i < map.size(); ++i) box.extend(map.photon(i).position);
@@ -132,10 +137,14 @@ Vec3 PhotonGatherer::estimate(const GatherPoint& p, GatherScratch& scratch, Phot
     const bool glossy = m.has_glossy_lobe();
     if (grid_) {
         ++stats.queries;
-        PhotonRun runs[27];
+        constexpr size_t kMaxRuns = 27;  // 3×3×3 cells: the radius is at most a cell (checked at construction)
+        PhotonRun runs[kMaxRuns];
         size_t count = 0;
         grid_->for_each_run(p.position, radius_, [&](PhotonRun r) {
-            if (count < 27) runs[count++] = r;
+            if (count == kMaxRuns)
+                throw Error("photon gather", "a query met more than 27 grid cells; the grid's cells must be at "
+                                             "least the gather radius");
+            runs[count++] = r;
         });
         return finish(m, sum_over_runs(grid_->view(), runs, count, p, scratch, stats));
     }
