@@ -24,6 +24,7 @@ public:
     }
 
     DagLevelTable& table(int level) { return tables_[level]; }
+    double lookup_ms() const { return merger_.lookup_ms(); }
 
     size_t table_bytes() const {
         size_t b = 0;
@@ -160,7 +161,6 @@ Svdag Svdag::from_voxels(const VoxelGrid& grid, std::span<const uint64_t> codes,
     const int shift = 3 * (depth - split_level);
     SvdagAssembler as(grid);
     Svdag dag;
-    Stopwatch merge_clock;
     std::vector<uint64_t> top_codes;
     std::vector<uint32_t> top_ids;
     size_t i = 0;
@@ -175,7 +175,7 @@ Svdag Svdag::from_voxels(const VoxelGrid& grid, std::span<const uint64_t> codes,
         i = j;
     }
     as.finish_top(split_level, std::move(top_codes), std::move(top_ids));
-    dag.stats_.dedup_ms = merge_clock.elapsed_ms();
+    dag.stats_.dedup_ms = as.lookup_ms();
     dag.stats_.table_bytes = as.table_bytes();
     as.assemble(dag);
     dag.stats_.input_nodes = codes.size();
@@ -196,7 +196,7 @@ Svdag Svdag::from_slices(const VoxelGrid& grid, int split_level, std::span<const
     Svdag dag;
     std::vector<uint64_t> top_codes;
     std::vector<uint32_t> top_ids;
-    double slice_ms = 0, merge_ms = 0;
+    double slice_ms = 0;
     uint64_t voxels = 0;
     for (size_t c = 0; c < cells.size(); ++c) {
         if (c > 0 && cells[c] <= cells[c - 1])
@@ -208,21 +208,17 @@ Svdag Svdag::from_slices(const VoxelGrid& grid, int split_level, std::span<const
         check_voxel_codes(grid, codes, "SVDAG");
         if ((codes.front() >> shift) != cells[c] || (codes.back() >> shift) != cells[c])
             throw Error("SVDAG", "a slice holds voxels outside its split cell " + std::to_string(cells[c]));
-        Stopwatch m;
         top_codes.push_back(cells[c]);
         top_ids.push_back(as.add_subtree(codes, split_level));
-        merge_ms += m.elapsed_ms();
         voxels += codes.size();
         ++dag.stats_.subtrees;
     }
-    Stopwatch m;
     as.finish_top(split_level, std::move(top_codes), std::move(top_ids));
-    merge_ms += m.elapsed_ms();
     dag.stats_.table_bytes = as.table_bytes();
     as.assemble(dag);
     dag.stats_.input_nodes = voxels;
     dag.stats_.split_level = split_level;
-    dag.stats_.dedup_ms = merge_ms;
+    dag.stats_.dedup_ms = as.lookup_ms();
     dag.stats_.voxelize_ms = slice_ms;
     dag.stats_.total_ms = clock.elapsed_ms() - slice_ms;
     dag.stats_.peak_rss_bytes = peak_rss_bytes();

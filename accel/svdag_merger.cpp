@@ -3,6 +3,7 @@
 #include "accel/child_mask.hpp"
 #include "core/error.hpp"
 #include "core/morton.hpp"
+#include "core/stats.hpp"
 
 namespace gilab {
 
@@ -43,35 +44,47 @@ uint32_t SvdagMerger::bottom_id(uint8_t mask) {
 void SvdagMerger::merge_leaves(std::span<const uint64_t> codes, std::vector<uint64_t>& out_codes,
                                std::vector<uint32_t>& out_ids) {
     out_codes.clear();
-    out_ids.clear();
+    masks_.clear();
     size_t i = 0;
     while (i < codes.size()) {
         uint64_t parent = codes[i] >> 3;
         uint8_t mask = 0;
         for (; i < codes.size() && (codes[i] >> 3) == parent; ++i) mask |= uint8_t(1u << (codes[i] & 7));
         out_codes.push_back(parent);
-        out_ids.push_back(bottom_id(mask));
+        masks_.push_back(mask);
     }
+    Stopwatch lookup;
+    out_ids.resize(masks_.size());
+    for (size_t k = 0; k < masks_.size(); ++k) out_ids[k] = bottom_id(masks_[k]);
+    lookup_ms_ += lookup.elapsed_ms();
 }
 
 void SvdagMerger::merge_up(int level, const std::vector<uint64_t>& codes, const std::vector<uint32_t>& ids,
                            std::vector<uint64_t>& out_codes, std::vector<uint32_t>& out_ids) {
     out_codes.clear();
-    out_ids.clear();
-    DagLevelTable& table = tables_[level - 1];
+    masks_.clear();
+    kids_.clear();
     size_t i = 0;
-    std::array<uint32_t, 8> kids;
     while (i < codes.size()) {
         uint64_t parent = codes[i] >> 3;
         uint8_t mask = 0;
-        uint32_t count = 0;
         for (; i < codes.size() && (codes[i] >> 3) == parent; ++i) {
             mask |= uint8_t(1u << (codes[i] & 7));
-            kids[count++] = ids[i];
+            kids_.push_back(ids[i]);
         }
         out_codes.push_back(parent);
-        out_ids.push_back(table.find_or_insert(mask, kids.data(), count));
+        masks_.push_back(mask);
     }
+    Stopwatch lookup;
+    DagLevelTable& table = tables_[level - 1];
+    out_ids.resize(masks_.size());
+    const uint32_t* kids = kids_.data();
+    for (size_t k = 0; k < masks_.size(); ++k) {
+        const uint32_t count = child_count(masks_[k]);
+        out_ids[k] = table.find_or_insert(masks_[k], kids, count);
+        kids += count;
+    }
+    lookup_ms_ += lookup.elapsed_ms();
 }
 
 uint32_t SvdagMerger::add_subtree(std::span<const uint64_t> codes, int top) {

@@ -43,6 +43,10 @@ public:
     // Ids cached from the tables become stale when the tables are rebuilt.
     void forget_cache() { mask_ids_.fill(kNoNode); }
 
+    // Time spent finding identical nodes (hashing keys and looking them up in the level
+    // tables), the paper's t_B; grouping children under their parents is not counted.
+    double lookup_ms() const { return lookup_ms_; }
+
     static constexpr uint32_t kNoNode = 0xffffffffu;
 
 private:
@@ -53,6 +57,10 @@ private:
     std::array<uint32_t, 256> mask_ids_;
     std::vector<uint64_t> codes_a_, codes_b_;
     std::vector<uint32_t> ids_a_, ids_b_;
+    // One level's parents, grouped before they are looked up: masks and children.
+    std::vector<uint8_t> masks_;
+    std::vector<uint32_t> kids_;
+    double lookup_ms_ = 0;
 };
 
 }  // namespace gilab

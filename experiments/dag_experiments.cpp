@@ -392,6 +392,15 @@ int repetitions_for(uint32_t res, bool quick) {
     return 1;
 }
 
+// t_A and t_B of repeated conversions.
+struct ConversionTimes {
+    std::vector<double> t_a, t_b;
+    void add(const SvdagBuildStats& s) {
+        t_a.push_back(s.total_ms);
+        t_b.push_back(s.dedup_ms);
+    }
+};
+
 ExperimentOutput run_table3(const ExperimentContext& ctx) {
     const std::vector<uint32_t> sizes = ctx.quick ? std::vector<uint32_t>{64, 128, 256}
                                                   : std::vector<uint32_t>{128, 256, 512, 1000, 2000, 4096, 8192};
@@ -407,9 +416,10 @@ ExperimentOutput run_table3(const ExperimentContext& ctx) {
     ResultTable table;
     table.title = "SVO→SVDAG conversion time t_A and identical-node search time t_B (ms, median over repetitions)";
     table.columns = {"scene",        "resolution", "method",       "split_level", "subtrees",   "repetitions",
-                     "voxels",       "svo_nodes",  "svdag_nodes",  "t_A_ms",      "t_B_ms",     "voxelize_ms",
+                     "voxels",       "svo_nodes",  "svdag_nodes",  "t_A_ms (1 thread)", "t_B_ms (1 thread)",
+                     "t_A_ms (all threads)", "t_B_ms (all threads)", "voxelize_ms",
                      "svo_build_ms", "peak_rss_MiB", "rss_before_MiB", "paper_t_A_ms", "paper_t_B_ms",
-                     "speedup_vs_paper_t_A"};
+                     "speedup_vs_paper_t_A (1 thread)", "speedup_vs_paper_t_A (all threads)"};
     std::vector<std::string> scenes;
     bool per_row_peak = true;
     for (const auto& model : open_models(ctx, out)) {
@@ -420,11 +430,12 @@ ExperimentOutput run_table3(const ExperimentContext& ctx) {
             const auto paper = paper_table3(model->scene, res);
             Voxelizer voxelizer(model->positions, model->triangles, grid);
             const uint64_t estimate = voxelizer.estimate_voxels(grid.full_region());  // about 2× the true count
-            auto add_paper = [&](json& row, double t_a) {
+            auto add_paper = [&](json& row, double t_a_one, double t_a_all) {
                 if (!paper) return;
                 row["paper_t_A_ms"] = paper->t_a;
                 row["paper_t_B_ms"] = paper->t_b;
-                row["speedup_vs_paper_t_A"] = paper->t_a / t_a;
+                row["speedup_vs_paper_t_A (1 thread)"] = paper->t_a / t_a_one;
+                row["speedup_vs_paper_t_A (all threads)"] = paper->t_a / t_a_all;
             };
 
             if (res <= max_whole) {
@@ -439,13 +450,14 @@ ExperimentOutput run_table3(const ExperimentContext& ctx) {
                     const size_t before = current_rss_bytes();
                     VoxelList voxels = voxelizer.voxelize();
                     Svo svo = Svo::build(voxels);
-                    std::vector<double> t_a, t_b;
+                    ConversionTimes all, one;
                     size_t dag_nodes = 0;
                     for (int r = 0; r < reps; ++r) {
                         Svdag dag = Svdag::from_svo(svo);
-                        t_a.push_back(dag.build_stats().total_ms);
-                        t_b.push_back(dag.build_stats().dedup_ms);
+                        all.add(dag.build_stats());
                         dag_nodes = dag.node_count();
+                        ThreadLimit single(1);
+                        one.add(Svdag::from_svo(svo).build_stats());
                     }
                     json row = {{"scene", model->label},
                                 {"resolution", res},
@@ -456,13 +468,15 @@ ExperimentOutput run_table3(const ExperimentContext& ctx) {
                                 {"voxels", voxels.size()},
                                 {"svo_nodes", svo.node_count()},
                                 {"svdag_nodes", dag_nodes},
-                                {"t_A_ms", median(t_a)},
-                                {"t_B_ms", median(t_b)},
+                                {"t_A_ms (1 thread)", median(one.t_a)},
+                                {"t_B_ms (1 thread)", median(one.t_b)},
+                                {"t_A_ms (all threads)", median(all.t_a)},
+                                {"t_B_ms (all threads)", median(all.t_b)},
                                 {"voxelize_ms", voxels.stats.ms},
                                 {"svo_build_ms", svo.build_ms()},
                                 {"peak_rss_MiB", mib(double(peak_rss_bytes()))},
                                 {"rss_before_MiB", mib(double(before))}};
-                    add_paper(row, median(t_a));
+                    add_paper(row, median(one.t_a), median(all.t_a));
                     table.rows.push_back(row);
                 }
             }
@@ -480,13 +494,17 @@ ExperimentOutput run_table3(const ExperimentContext& ctx) {
                         std::to_string(reps));
                 per_row_peak = reset_peak_rss() && per_row_peak;
                 const size_t before = current_rss_bytes();
-                std::vector<double> t_a, t_b, vox_ms;
+                ConversionTimes all, one;
+                std::vector<double> vox_ms;
                 size_t dag_nodes = 0;
                 uint64_t voxels = 0, subtrees = 0;
                 for (int r = 0; r < reps; ++r) {
                     Svdag dag = Svdag::from_voxelizer(voxelizer, split_level);
-                    t_a.push_back(dag.build_stats().total_ms);
-                    t_b.push_back(dag.build_stats().dedup_ms);
+                    all.add(dag.build_stats());
+                    {
+                        ThreadLimit single(1);
+                        one.add(Svdag::from_voxelizer(voxelizer, split_level).build_stats());
+                    }
                     vox_ms.push_back(dag.build_stats().voxelize_ms);
                     dag_nodes = dag.node_count();
                     voxels = dag.build_stats().input_nodes;
@@ -500,12 +518,14 @@ ExperimentOutput run_table3(const ExperimentContext& ctx) {
                             {"repetitions", reps},
                             {"voxels", voxels},
                             {"svdag_nodes", dag_nodes},
-                            {"t_A_ms", median(t_a)},
-                            {"t_B_ms", median(t_b)},
+                            {"t_A_ms (1 thread)", median(one.t_a)},
+                            {"t_B_ms (1 thread)", median(one.t_b)},
+                            {"t_A_ms (all threads)", median(all.t_a)},
+                            {"t_B_ms (all threads)", median(all.t_b)},
                             {"voxelize_ms", median(vox_ms)},
                             {"peak_rss_MiB", mib(double(peak_rss_bytes()))},
                             {"rss_before_MiB", mib(double(before))}};
-                add_paper(row, median(t_a));
+                add_paper(row, median(one.t_a), median(all.t_a));
                 table.rows.push_back(row);
             }
         }
@@ -528,18 +548,20 @@ ExperimentOutput run_table3(const ExperimentContext& ctx) {
         "Whole rows: t_A = Svdag::from_svo on an SVO already in memory (bottom-up merge + layout in the paper's "
         "format), t_B = the part spent hashing nodes and finding identical ones; voxelization and SVO build are "
         "reported apart and not in t_A. Split rows (the paper's rule above 256³): each 256³ subtree is voxelized on its "
-        "own, merged into shared per-level tables, and the roots joined; t_A excludes voxelization (voxelize_ms), and "
-        "t_B is the whole merge, since the split build groups children and looks up identical nodes in one pass.");
+        "own, merged into shared per-level tables, and the roots joined; t_A excludes voxelization (voxelize_ms). In "
+        "both, t_B is the same thing: the time spent hashing parents' keys and looking them up in the per-level "
+        "tables of unique nodes (grouping children under their parents and the layout are in t_A only).");
     out.notes.push_back(
         "peak_rss_MiB is the row's own peak resident memory (VmHWM reset before the row), which includes what the "
         "process held before the row (rss_before_MiB: program, mesh, allocator caches); for whole rows it covers "
         "the voxel list, the SVO and the conversions, for split rows the voxelizer and one subtree at a time.");
     out.notes.push_back(
-        "The paper's times are on its own CPU (single-threaded, not stated otherwise); the paper converted above 256³ "
-        "with its split rule, so its 512³–2000³ figures compare best with our split rows. speedup_vs_paper_t_A = paper "
-        "t_A / our t_A. Our whole conversion hashes each level's nodes in parallel on all threads and looks them up in "
-        "one open-addressing table per level; the final layout is cheap, so t_B is most of t_A here, while the "
-        "paper's t_B is 12–40% of its t_A.");
+        "The paper's times are on its own CPU; it does not state a thread count, so it is compared with our 1-thread "
+        "figures (each repetition converts once at all threads and once under a 1-thread limit), and the all-thread "
+        "figures stand beside. The paper converted above 256³ with its split rule, so its 512³–2000³ figures compare "
+        "best with our split rows. speedup_vs_paper_t_A = paper t_A / our t_A. Our whole conversion hashes each "
+        "level's nodes in parallel and looks them up in one open-addressing table per level; the final layout is "
+        "cheap, so t_B is most of t_A here, while the paper's t_B is 12–40% of its t_A.");
     out.notes.push_back("Wall-clock times; other work on the machine slows them (config: load_average_at_start/end).");
     if (!per_row_peak) out.notes.push_back("VmHWM could not be reset on this system: peak_rss_MiB is process-wide.");
     return out;
