@@ -328,10 +328,23 @@ TEST(VctTechnique, StereoLayersAndProvenance) {
     for (const char* key : {"update_ms", "injection_ms", "primary_ms", "direct_ms", "diffuse_ms", "specular_ms", "total_ms",
                             "structure_bytes", "occupied_voxels"})
         EXPECT_TRUE(s.has(key)) << key;
-    // ao in [0, 1]; colour = direct + indirect + specular.
-    for (size_t i = 0; i < films[0].pixel_count(); ++i) {
-        EXPECT_GE(films[0].layer("ao").data[i], 0.0f);
-        EXPECT_LE(films[0].layer("ao").data[i], 1.0f);
+    // ao in [0, 1]; colour = direct + indirect + specular, channel by channel.
+    for (const Film& film : films) {
+        const auto& color = film.layer("color").data;
+        const auto& direct = film.layer("direct").data;
+        const auto& indirect = film.layer("indirect").data;
+        const auto& specular = film.layer("specular").data;
+        double lit = 0;
+        for (size_t i = 0; i < film.pixel_count(); ++i) {
+            EXPECT_GE(film.layer("ao").data[i], 0.0f);
+            EXPECT_LE(film.layer("ao").data[i], 1.0f);
+            for (size_t c = 3 * i; c < 3 * i + 3; ++c) {
+                const float sum = direct[c] + indirect[c] + specular[c];
+                EXPECT_NEAR(color[c], sum, 1e-5f * std::max(1.0f, std::abs(sum))) << "pixel " << i;
+                lit += indirect[c];
+            }
+        }
+        EXPECT_GT(lit, 0.0) << "the indirect layer should not be empty";
     }
 }
 
