@@ -3,6 +3,7 @@
 #include <filesystem>
 #include "core/error.hpp"
 #include "core/image_io.hpp"
+#include "core/scene_hash.hpp"
 #include "core/settings.hpp"
 #include "techniques/technique.hpp"
 
@@ -13,8 +14,13 @@ namespace fs = std::filesystem;
 Film path_reference(const ExperimentContext& ctx, const Scene& scene, const EyeCamera& camera, int spp,
                      std::vector<std::string>& files) {
     nlohmann::json settings = {{"spp", spp}, {"seed", ctx.seed}, {"max_depth", 8}, {"jitter", false}};
+    // The key: the scene's content, every setting given to the path tracer (the rest are
+    // its defaults, which are part of its code), the digest of the path tracer's code,
+    // and the camera.
     nlohmann::json key = settings;
     key["scene"] = scene.name;
+    key["scene_content"] = scene_content_hash(scene);
+    key["path_tracer_revision"] = GILAB_PATH_TRACER_REVISION;
     key["width"] = camera.width();
     key["height"] = camera.height();
     const Vec3& p = camera.position();

@@ -1,7 +1,8 @@
 #pragma once
 // The path-traced reference the photon experiments compare against: pixel centres (as
-// the photon technique renders), max depth 8, cached by its settings in the experiment's
-// directory or copied from a sibling pm-* directory that already rendered it.
+// the photon technique renders), max depth 8, cached in the experiment's directory (or
+// copied from a sibling pm-* directory that already rendered it) under a name that holds
+// a digest of the scene's content, the path tracer's settings and code, and the camera.
 #include <string>
 #include <vector>
 #include "core/camera.hpp"
