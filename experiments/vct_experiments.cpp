@@ -463,6 +463,8 @@ void save_images(const ExperimentContext& ctx, ExperimentOutput& out, const std:
 
 const char* kPhases[] = {"primary_ms", "update_ms", "injection_ms", "direct_ms", "diffuse_ms", "specular_ms", "total_ms"};
 
+std::vector<EyeCamera> sponza_path(const RenderSetup& s, int frames);
+
 ExperimentOutput run_table7(const ExperimentContext& ctx) {
     ExperimentOutput out;
     quick_note(ctx, out);
@@ -484,8 +486,21 @@ ExperimentOutput run_table7(const ExperimentContext& ctx) {
             render(*techniques[v], s.camera);
             Stats st = techniques[v]->stats();
             for (const char* k : kPhases) times[v][k].push_back(st.get(k));
+            // The paper's totals leave the dynamic update out and give it on its own.
+            times[v]["total_ms"].back() -= st.get("update_ms");
             bytes[v] = st.get("structure_bytes");
         }
+    // The update matters when the viewer moves: timed on the walk down the nave, where the
+    // cascades scroll (a fixed camera would leave them nothing to do).
+    const std::vector<EyeCamera> walk = sponza_path(s, ctx.quick ? 3 : 12);
+    std::vector<std::vector<double>> walk_update(variants.size());
+    for (size_t v = 0; v < variants.size(); ++v) {
+        auto moving = make_vct(s.scene, variants[v].settings, ctx);
+        for (size_t f = 0; f < walk.size(); ++f) {
+            render(*moving, walk[f]);
+            if (f > 0) walk_update[v].push_back(moving->stats().get("update_ms"));  // the first frame builds
+        }
+    }
     ResultTable t;
     t.title = "Table 7 — per-frame time by phase (ms), Sponza, dense mip VCT vs cascaded";
     t.columns = {"phase", "dense_ms", "cascaded_ms", "cascaded_over_dense", "paper VXGI_ms", "paper cascaded_ms"};
@@ -494,10 +509,16 @@ ExperimentOutput run_table7(const ExperimentContext& ctx) {
         {"diffuse_ms", {9.2, 6.5}},   {"specular_ms", {8.0, 5.2}},    {"total_ms", {36.7, 26.5}},
         {"update_ms", {15.5, 2.0}}};
     for (const char* k : kPhases) {
-        double d = median(times[0][k]), c = median(times[1][k]);
+        const bool update = std::string(k) == "update_ms";
+        const double d = update ? median(walk_update[0]) : median(times[0][k]);
+        const double c = update ? median(walk_update[1]) : median(times[1][k]);
         auto p = paper.at(k);
-        t.rows.push_back({{"phase", k}, {"dense_ms", d}, {"cascaded_ms", c}, {"cascaded_over_dense", d > 0 ? c / d : 0.0},
-                          {"paper VXGI_ms", p.first}, {"paper cascaded_ms", p.second}});
+        const std::string phase = update ? "update_ms (per frame on the walk, not in the total)"
+                                  : std::string(k) == "total_ms" ? "total_ms (without the update)"
+                                                                 : std::string(k);
+        t.rows.push_back({{"phase", phase}, {"dense_ms", d}, {"cascaded_ms", c},
+                          {"cascaded_over_dense", d > 0 ? c / d : 0.0}, {"paper VXGI_ms", p.first},
+                          {"paper cascaded_ms", p.second}});
     }
     out.tables.push_back(t);
     out.config = {{"scene", "sponza (stone made glossy: specular 0.15, Phong 60)"},
@@ -512,7 +533,10 @@ ExperimentOutput run_table7(const ExperimentContext& ctx) {
                         "paper's 15.5 ms; cascaded: scheduled scrolling and border voxelization — the paper's 2.0 ms); "
                         "injection = direct light into the voxels + anisotropic filtering + the voxel bounce (16 cones "
                         "per voxel face); direct = ray-traced direct light at the pixels; diffuse = 16 cones per pixel; "
-                        "specular = one cone per glossy pixel. The paper's total excludes the update; ours includes it.");
+                        "specular = one cone per glossy pixel. As in the paper, the total leaves the update out: it is "
+                        "primary + injection + direct + diffuse + specular at the fixed camera, median over frames. "
+                        "The update row is timed apart, on the walk down the nave (frames after the first, median), "
+                        "where the cascades must scroll.");
     out.notes.push_back("CPU (all threads) vs the paper's GPU: compare the cascaded/dense ratios, not milliseconds.");
     return out;
 }
