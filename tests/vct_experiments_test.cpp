@@ -68,3 +68,28 @@ TEST(VctExperiments, MemoryIsInMegabytesOfTenToTheSixBytes) {
 }
 
 }  // namespace
+
+namespace {
+
+// Tables 3–4 time every structure from both voxelizers, except the cascades, which need
+// the fragment voxelizer's per-face attributes.
+TEST(VctExperiments, EveryStructureIsTimedFromBothVoxelizers) {
+    const ExperimentOutput out = test::run_quick_experiment(vct_registry(), "vct-table3");
+    int rows = 0;
+    for (const json& row : out.tables.at(0).rows) {
+        const json& overlap = row.at("voxelize_ms (overlap voxelizer)");
+        const json& fragment = row.at("voxelize_ms (fragment voxelizer)");
+        ASSERT_TRUE(fragment.is_number()) << row.dump();
+        EXPECT_GT(fragment.get<double>(), 0.0);
+        if (row.at("structure") == "cascaded") {
+            EXPECT_TRUE(overlap.is_null()) << row.dump();
+        } else {
+            ASSERT_TRUE(overlap.is_number()) << row.dump();
+            EXPECT_GT(overlap.get<double>(), 0.0);
+        }
+        ++rows;
+    }
+    EXPECT_GE(rows, 6);
+}
+
+}  // namespace
