@@ -4,12 +4,28 @@
 // is there), and every row of every table holds every column.
 #include <gtest/gtest.h>
 #include <filesystem>
+#include <initializer_list>
 #include <string>
 #include "experiments/experiment.hpp"
 #include "experiments/plot.hpp"
 #include "tests/test_support.hpp"
 
 namespace gilab::test {
+
+// A registry holding the given groups of experiments (register_*_experiments).
+inline ExperimentRegistry registry_with(std::initializer_list<void (*)(ExperimentRegistry&)> groups) {
+    ExperimentRegistry registry;
+    for (auto add : groups) add(registry);
+    return registry;
+}
+
+// A test name from an experiment name ("vct-table1" → "vct_table1").
+inline std::string test_name_of(const testing::TestParamInfo<const char*>& info) {
+    std::string name = info.param;
+    for (char& c : name)
+        if (c == '-') c = '_';
+    return name;
+}
 
 inline ExperimentOutput run_quick_experiment(const ExperimentRegistry& registry, const std::string& name) {
     namespace fs = std::filesystem;

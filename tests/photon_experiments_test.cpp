@@ -16,20 +16,9 @@ using namespace gilab;
 using nlohmann::json;
 
 const ExperimentRegistry& photon_registry() {
-    static const ExperimentRegistry registry = [] {
-        ExperimentRegistry r;
-        register_photon_experiments(r);
-        register_stereo_experiments(r);
-        return r;
-    }();
+    static const ExperimentRegistry registry =
+        test::registry_with({register_photon_experiments, register_stereo_experiments});
     return registry;
-}
-
-std::string name_of(const testing::TestParamInfo<const char*>& info) {
-    std::string name = info.param;
-    for (char& c : name)
-        if (c == '-') c = '_';
-    return name;
 }
 
 class PhotonQuickExperiment : public testing::TestWithParam<const char*> {};
@@ -40,7 +29,7 @@ TEST_P(PhotonQuickExperiment, RunsAndFillsEveryColumn) {
 }
 
 INSTANTIATE_TEST_SUITE_P(All, PhotonQuickExperiment,
-                         testing::Values("pm-fig8", "pm-table5", "pm-final", "pm-foveated"), name_of);
+                         testing::Values("pm-fig8", "pm-table5", "pm-final", "pm-foveated"), test::test_name_of);
 
 // P1 Tables 1–4 (ms): (photons, radius, variant) → published frame time.
 using Key = std::tuple<std::string, double, std::string>;
@@ -103,6 +92,6 @@ TEST_P(PhotonPaperColumns, EveryRowCarriesItsPublishedFigure) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Tables, PhotonPaperColumns,
-                         testing::Values("pm-table1", "pm-table2", "pm-table3", "pm-table4"), name_of);
+                         testing::Values("pm-table1", "pm-table2", "pm-table3", "pm-table4"), test::test_name_of);
 
 }  // namespace

@@ -15,11 +15,7 @@ using namespace gilab;
 using nlohmann::json;
 
 const ExperimentRegistry& vct_registry() {
-    static const ExperimentRegistry registry = [] {
-        ExperimentRegistry r;
-        register_vct_experiments(r);
-        return r;
-    }();
+    static const ExperimentRegistry registry = test::registry_with({register_vct_experiments});
     return registry;
 }
 
@@ -36,12 +32,7 @@ INSTANTIATE_TEST_SUITE_P(All, VctQuickExperiment,
                          testing::Values("vct-table1", "vct-table2", "vct-table3", "vct-table4", "vct-table5",
                                          "vct-table6", "vct-table7", "vct-fig9", "vct-fig10", "vct-fig11",
                                          "vct-fig12-13", "vct-stability"),
-                         [](const testing::TestParamInfo<const char*>& info) {
-                             std::string name = info.param;
-                             for (char& c : name)
-                                 if (c == '-') c = '_';
-                             return name;
-                         });
+                         test::test_name_of);
 
 TEST(VctExperiments, MemoryIsInMegabytesOfTenToTheSixBytes) {
     const ExperimentOutput out = test::run_quick_experiment(vct_registry(), "vct-table5");
