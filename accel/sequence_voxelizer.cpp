@@ -326,18 +326,18 @@ std::vector<uint64_t> SequenceVoxelizer::slice(uint64_t cell, FrameState& frame)
     // This cell and the ones likely asked for next (the following dirty cells when it is
     // dirty, else the following cells), voxelized in parallel.
     const auto& order = std::binary_search(frame.dirty.begin(), frame.dirty.end(), cell) ? frame.dirty : frame.cells;
-    std::vector<uint64_t> todo{cell};
-    for (auto it = std::upper_bound(order.begin(), order.end(), cell); it != order.end() && todo.size() < kBatchCells;
-         ++it)
-        todo.push_back(*it);
-    std::vector<std::vector<uint64_t>> results(todo.size());
+    std::vector<uint64_t> batch_cells{cell};
+    for (auto it = std::upper_bound(order.begin(), order.end(), cell);
+         it != order.end() && batch_cells.size() < kBatchCells; ++it)
+        batch_cells.push_back(*it);
+    std::vector<std::vector<uint64_t>> results(batch_cells.size());
     // Isolated, so a thread waiting inside one cell's voxelizer never starts another
     // cell: at most one voxelizer per thread is alive.
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, todo.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, batch_cells.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i < r.end(); ++i)
-            tbb::this_task_arena::isolate([&] { results[i] = voxelize_cell(todo[i], frame); });
+            tbb::this_task_arena::isolate([&] { results[i] = voxelize_cell(batch_cells[i], frame); });
     });
-    for (size_t i = 1; i < todo.size(); ++i) frame.batch.emplace_back(todo[i], std::move(results[i]));
+    for (size_t i = 1; i < batch_cells.size(); ++i) frame.batch.emplace_back(batch_cells[i], std::move(results[i]));
     return std::move(results[0]);
 }
 

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <map>
 #include "experiments/experiment.hpp"
+#include "tests/experiment_test_support.hpp"
 #include "tests/test_support.hpp"
 
 namespace {
@@ -16,11 +17,7 @@ using nlohmann::json;
 namespace fs = std::filesystem;
 
 const ExperimentRegistry& dag_registry() {
-    static const ExperimentRegistry registry = [] {
-        ExperimentRegistry r;
-        register_dag_experiments(r);
-        return r;
-    }();
+    static const ExperimentRegistry registry = test::registry_with({register_dag_experiments});
     return registry;
 }
 

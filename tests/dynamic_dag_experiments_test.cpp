@@ -16,11 +16,7 @@ using nlohmann::json;
 namespace fs = std::filesystem;
 
 const ExperimentRegistry& dynamic_registry() {
-    static const ExperimentRegistry registry = [] {
-        ExperimentRegistry r;
-        register_dynamic_dag_experiments(r);
-        return r;
-    }();
+    static const ExperimentRegistry registry = test::registry_with({register_dynamic_dag_experiments});
     return registry;
 }
 

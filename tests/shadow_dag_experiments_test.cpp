@@ -17,11 +17,7 @@ using nlohmann::json;
 namespace fs = std::filesystem;
 
 const ExperimentRegistry& shadow_registry() {
-    static const ExperimentRegistry registry = [] {
-        ExperimentRegistry r;
-        register_shadow_dag_experiments(r);
-        return r;
-    }();
+    static const ExperimentRegistry registry = test::registry_with({register_shadow_dag_experiments});
     return registry;
 }
 
