@@ -6,6 +6,7 @@
 #include <fstream>
 #include "core/error.hpp"
 #include "core/mesh_loaders.hpp"
+#include "core/ray_tracer.hpp"
 #include "core/scene_file.hpp"
 #include "tests/test_support.hpp"
 
@@ -324,6 +325,29 @@ TEST(ShippedScenes, KitchenMergesAllPartsWithManifestCounts) {
     std::map<std::string, int> names;
     for (const auto& m : s.materials) ++names[m.name];
     for (const auto& [name, n] : names) EXPECT_LE(n, 2) << name;
+}
+
+// P3 measures Sibenik from inside its nave: the camera stands between the floor (a
+// standing eye height below it), the vault above and the side walls, and sees down the
+// nave (its forward ray travels at least half the cathedral's length).
+TEST(ShippedScenes, SibenikCameraStandsInsideTheNave) {
+    if (!test::shared_asset("sibenik/sibenik.obj")) GTEST_SKIP() << "sibenik not found";
+    Scene s = load_scene_file(fs::path(GILAB_SOURCE_DIR) / "scenes" / "sibenik.json", AssetPaths::from_environment());
+    EXPECT_EQ(s.triangle_count() + s.degenerate_triangles_dropped, 75284u);
+    const SceneFrame frame = s.evaluate(0.0);
+    const RayTracer tracer(frame);
+    const Vec3 eye = s.camera->position;
+    auto distance = [&](Vec3 direction) {
+        const Hit h = tracer.intersect(Ray{eye, glm::normalize(direction)});
+        return h.valid() ? h.t : kInfinity;
+    };
+    const float floor = distance(Vec3(0, -1, 0));
+    EXPECT_GT(floor, 1.0f);
+    EXPECT_LT(floor, 3.0f);
+    EXPECT_LT(distance(Vec3(0, 1, 0)), 30.0f) << "no vault above the camera";
+    EXPECT_LT(distance(Vec3(0, 0, 1)), 9.0f) << "no wall on the +z side";
+    EXPECT_LT(distance(Vec3(0, 0, -1)), 9.0f) << "no wall on the -z side";
+    EXPECT_GT(distance(s.camera->target - eye), 0.5f * frame.bounds.extent().x);
 }
 
 // The five animated samples move by their own skinned animation, not a turntable, and
