@@ -1,5 +1,6 @@
 #include "accel/hash_grid_photon_map.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include "core/error.hpp"
@@ -82,7 +83,9 @@ void HashGridPhotonMap::build(std::vector<Photon> photons, float radius) {
     std::vector<uint32_t> cursor(start_.begin(), start_.end() - 1);
     photons_.resize(photons.size());
     original_.resize(photons.size());
-    soa_.resize(photons.size());
+    // The first-hit flags only when some photon is a first-hit copy (direct light in the map).
+    const bool with_first = std::any_of(photons.begin(), photons.end(), [](const Photon& p) { return p.first_hit(); });
+    soa_.resize(photons.size(), with_first);
     for (size_t i = 0; i < photons.size(); ++i) {
         uint32_t slot = cursor[key[i]]++;
         photons_[slot] = photons[i];

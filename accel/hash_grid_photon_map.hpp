@@ -51,7 +51,7 @@ public:
     const glm::ivec3& grid_size() const { return size_; }
     size_t cell_count() const { return start_.empty() ? 0 : start_.size() - 1; }
     const std::vector<uint32_t>& start_index() const { return start_; }
-    // Positions, incoming directions and power in the sorted (cell) order.
+    // Positions, incoming directions, power and first-hit flags in the sorted (cell) order.
     const PhotonSoA& soa() const { return soa_; }
     PhotonSoAView view() const { return PhotonSoAView::of(soa_); }
 

@@ -32,6 +32,13 @@ nlohmann::json with(nlohmann::json base, const nlohmann::json& extra) {
     return base;
 }
 
+// The same settings with P1's photon map: direct light from first-hit photons, no light samples.
+nlohmann::json every_hit(nlohmann::json base) {
+    base.erase("light_samples");
+    base["photon_storage"] = "every_hit";
+    return base;
+}
+
 std::vector<Film> render_views(const Scene& scene, const ViewSet& views, const nlohmann::json& settings_json,
                                Stats* stats = nullptr) {
     PhotonMappingTechnique t;
@@ -178,20 +185,29 @@ TEST(StereoReuse, LambertianReusedRightEyeEqualsIndependentRender) {
     Scene scene = make_cornell_box();
     const WallPair pair = wall_pair(scene, 128, 144);
     const ViewSet views = ViewSet::stereo_pair(pair.left, pair.right);
-    Stats stats;
-    std::vector<Film> separate = render_views(scene, views, kBase);
-    std::vector<Film> reused = render_views(scene, views, with(kBase, {{"stereo_reuse", true}}), &stats);
     const std::vector<bool> wall = back_wall_pixels(scene, pair.right, pair.wall_z);
+    for (const nlohmann::json& base : {kBase, every_hit(kBase)}) {
+        Stats stats;
+        std::vector<Film> separate = render_views(scene, views, base);
+        std::vector<Film> reused = render_views(scene, views, with(base, {{"stereo_reuse", true}}), &stats);
 
-    // The left eye is the same render either way.
-    EXPECT_EQ(std::memcmp(separate[0].layer("color").data.data(), reused[0].layer("color").data.data(),
-                          separate[0].layer("color").data.size() * sizeof(float)),
-              0);
-    WallComparison c = compare_on_wall(reused[1], separate[1], wall);
-    EXPECT_GT(c.compared, 600u);
-    EXPECT_LT(c.max_relative, 1e-4) << "reused right pixels on the back wall differ from the independent render";
-    // Elsewhere the reused point lies anywhere in the right pixel (strict mode's test).
-    EXPECT_GT(stats.get("reuse_fraction"), 0.8);
+        // The left eye is the same render either way.
+        EXPECT_EQ(std::memcmp(separate[0].layer("color").data.data(), reused[0].layer("color").data.data(),
+                              separate[0].layer("color").data.size() * sizeof(float)),
+                  0);
+        WallComparison c = compare_on_wall(reused[1], separate[1], wall);
+        EXPECT_GT(c.compared, 600u) << base.dump();
+        EXPECT_LT(c.max_relative, 1e-4) << base.dump()
+                                        << ": reused right pixels on the back wall differ from the independent render";
+        // Elsewhere the reused point lies anywhere in the right pixel (strict mode's test).
+        EXPECT_GT(stats.get("reuse_fraction"), 0.8);
+        // Reused pixels keep the direct / indirect split: color = direct + indirect.
+        const Film& right = reused[1];
+        size_t bad = 0;
+        for (size_t k = 0; k < right.layer("color").data.size(); ++k)
+            bad += right.layer("color").data[k] != right.layer("direct").data[k] + right.layer("indirect").data[k];
+        EXPECT_EQ(bad, 0u) << base.dump();
+    }
 }
 
 TEST(StereoReuse, GlossyNeedsTheLobeReshadedForTheRightEye) {
@@ -201,16 +217,20 @@ TEST(StereoReuse, GlossyNeedsTheLobeReshadedForTheRightEye) {
     scene.materials[0].phong_exponent = 400.0f;
     const WallPair pair = wall_pair(scene, 128, 144);
     const ViewSet views = ViewSet::stereo_pair(pair.left, pair.right);
-    std::vector<Film> separate = render_views(scene, views, kBase);
-    std::vector<Film> reshaded = render_views(scene, views, with(kBase, {{"stereo_reuse", true}}));
-    std::vector<Film> copied = render_views(scene, views, with(kBase, {{"stereo_reuse", true}, {"stereo_reshade", false}}));
     const std::vector<bool> wall = back_wall_pixels(scene, pair.right, pair.wall_z);
+    // With every-hit storage the glossy direct light comes from the map too: the right
+    // eye re-gathers both parts for its own direction.
+    for (const nlohmann::json& base : {kBase, every_hit(kBase)}) {
+        std::vector<Film> separate = render_views(scene, views, base);
+        std::vector<Film> reshaded = render_views(scene, views, with(base, {{"stereo_reuse", true}}));
+        std::vector<Film> copied = render_views(scene, views, with(base, {{"stereo_reuse", true}, {"stereo_reshade", false}}));
 
-    WallComparison good = compare_on_wall(reshaded[1], separate[1], wall);
-    WallComparison bad = compare_on_wall(copied[1], separate[1], wall);
-    EXPECT_GT(good.compared, 600u);
-    EXPECT_LT(good.max_relative, 1e-4);
-    EXPECT_GT(bad.mean_relative, 0.05) << "copying the left eye's glossy colour should be visibly wrong";
+        WallComparison good = compare_on_wall(reshaded[1], separate[1], wall);
+        WallComparison bad = compare_on_wall(copied[1], separate[1], wall);
+        EXPECT_GT(good.compared, 600u) << base.dump();
+        EXPECT_LT(good.max_relative, 1e-4) << base.dump();
+        EXPECT_GT(bad.mean_relative, 0.05) << base.dump() << ": copying the left eye's glossy colour should be visibly wrong";
+    }
 }
 
 // Left hits of a small render, as the technique computes them (geometry only).
@@ -373,6 +393,7 @@ TEST(StereoReuse, IdenticalAtAnyThreadCount) {
     for (nlohmann::json s : {with(kBase, {{"stereo_reuse", true}}),
                              with(kBase, {{"stereo_reuse", true}, {"stereo_match", "strict"}, {"light_samples", 2}}),
                              with(kBase, {{"stereo_reuse", true}, {"stereo_fill", true}}),
+                             with(every_hit(kBase), {{"stereo_reuse", true}, {"stereo_match", "strict"}}),
                              with(kBase, {{"foveated", true}, {"fovea_angle", 15}}),
                              with(kBase, {{"foveated", true}, {"fovea_angle", 15}, {"stereo_reuse", true}})}) {
         std::vector<Film> one, two;
@@ -500,6 +521,8 @@ TEST(StereoReuse, BadSettingsAreErrorsNamingTheKey) {
     EXPECT_NE(error(with(kBase, {{"foveated", true}, {"pass", "split"}})).find("foveated"), std::string::npos);
     EXPECT_NE(error(with(kBase, {{"foveated", true}, {"tile_size", 6}})).find("tile_size"), std::string::npos);
     EXPECT_NE(error(with(kBase, {{"foveated", true}, {"gaze_yaw", 120}})).find("gaze_yaw"), std::string::npos);
+    // Foveation keeps direct light per pixel by shadow rays: not with direct light from the map.
+    EXPECT_NE(error(with(every_hit(kBase), {{"foveated", true}})).find("photon_storage"), std::string::npos);
 }
 
 }  // namespace

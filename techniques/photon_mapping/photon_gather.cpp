@@ -16,13 +16,16 @@ constexpr int kLanes = 8;
 // twice, for AVX2 (one 8-wide vector per step) and the SSE2 baseline (two 4-wide
 // vectors), chosen at load time. Each lane performs the same IEEE operations in the same
 // order either way (no FMA contraction in ISO C++ mode), so the two should agree bit for
-// bit; within one process only one of them is ever used.
-__attribute__((target_clones("avx2", "default"))) Vec3 sum_flux_runs(const PhotonSoAView& v, const PhotonRun* runs, size_t count, const Vec3& x, const Vec3& n,
-                   float r2, uint64_t& visited, uint64_t& inside) {
+// bit; within one process only one of them is ever used. When the SoA carries first-hit
+// flags the first-hit photons go to their own partial sums (the direct part).
+__attribute__((target_clones("avx2", "default"))) PhotonEstimate sum_flux_runs(
+    const PhotonSoAView& v, const PhotonRun* runs, size_t count, const Vec3& x, const Vec3& n, float r2,
+    uint64_t& visited, uint64_t& inside) {
     alignas(32) float ar[kLanes] = {}, ag[kLanes] = {}, ab[kLanes] = {}, ac[kLanes] = {};
+    alignas(32) float dr[kLanes] = {}, dg[kLanes] = {}, db[kLanes] = {};
     const float qx = x.x, qy = x.y, qz = x.z, nx = n.x, ny = n.y, nz = n.z;
     const float *px = v.x, *py = v.y, *pz = v.z, *wx = v.wx, *wy = v.wy, *wz = v.wz;
-    const float *pr = v.r, *pg = v.g, *pb = v.b;
+    const float *pr = v.r, *pg = v.g, *pb = v.b, *pf = v.first;
     // Branch-free lane body: masks as 0/1 factors (a photon's flux times 0 or 1 is exact,
     // and per-lane counts stay far below 2^24, so float counters are exact too).
     // (size_t indices: with 32-bit ones the compiler cannot prove that lanes are adjacent
@@ -38,27 +41,55 @@ __attribute__((target_clones("avx2", "default"))) Vec3 sum_flux_runs(const Photo
         ab[l] += w * pb[j];
         ac[l] += in;
     };
+    // The same with the first-hit flag f ∈ {0, 1} splitting w into w·f and w − w·f (exact).
+    auto lane_split = [&](int l, size_t j) {
+        float dx = qx - px[j], dy = qy - py[j], dz = qz - pz[j];
+        float d2 = dx * dx + dy * dy + dz * dz;
+        float c = wx[j] * nx + wy[j] * ny + wz[j] * nz;
+        float in = d2 <= r2 ? 1.0f : 0.0f;
+        float w = c > 0.0f ? in : 0.0f;
+        float wd = w * pf[j], wi = w - wd;
+        ar[l] += wi * pr[j];
+        ag[l] += wi * pg[j];
+        ab[l] += wi * pb[j];
+        dr[l] += wd * pr[j];
+        dg[l] += wd * pg[j];
+        db[l] += wd * pb[j];
+        ac[l] += in;
+    };
     uint64_t seen = 0;
     for (size_t k = 0; k < count; ++k) {
         size_t i = runs[k].begin;
         const size_t end = runs[k].end;
         seen += end - i;
-        for (; i + kLanes <= end; i += kLanes)
-            for (int l = 0; l < kLanes; ++l) lane(l, i + size_t(l));
-        for (int l = 0; i < end; ++i, ++l) lane(l, i);
+        if (pf) {
+            for (; i + kLanes <= end; i += kLanes)
+                for (int l = 0; l < kLanes; ++l) lane_split(l, i + size_t(l));
+            for (int l = 0; i < end; ++i, ++l) lane_split(l, i);
+        } else {
+            for (; i + kLanes <= end; i += kLanes)
+                for (int l = 0; l < kLanes; ++l) lane(l, i + size_t(l));
+            for (int l = 0; i < end; ++i, ++l) lane(l, i);
+        }
     }
-    Vec3 sum(0.0f);
+    PhotonEstimate sum;
     float in = 0.0f;
     for (int l = 0; l < kLanes; ++l) {
-        sum.x += ar[l];
-        sum.y += ag[l];
-        sum.z += ab[l];
+        sum.indirect.x += ar[l];
+        sum.indirect.y += ag[l];
+        sum.indirect.z += ab[l];
+        sum.direct.x += dr[l];
+        sum.direct.y += dg[l];
+        sum.direct.z += db[l];
         in += ac[l];
     }
     visited += seen;
     inside += uint64_t(in);
     return sum;
 }
+
+// The part a photon's contribution belongs to.
+Vec3& part_of(PhotonEstimate& e, bool first_hit) { return first_hit ? e.direct : e.indirect; }
 
 }  // namespace
 
@@ -84,12 +115,13 @@ PhotonGatherer::PhotonGatherer(const PhotonMap& map, const std::vector<Material>
     }
 }
 
-Vec3 PhotonGatherer::finish(const Material& m, const Vec3& sum) const {
-    if (m.has_glossy_lobe()) return sum * inv_area_;
-    return bsdf_diffuse(m) * (sum * inv_area_);
+PhotonEstimate PhotonGatherer::finish(const Material& m, const PhotonEstimate& sum) const {
+    if (m.has_glossy_lobe()) return {sum.direct * inv_area_, sum.indirect * inv_area_};
+    const Vec3 f = bsdf_diffuse(m);
+    return {f * (sum.direct * inv_area_), f * (sum.indirect * inv_area_)};
 }
 
-Vec3 PhotonGatherer::sum_over_runs(const PhotonSoAView& v, const PhotonRun* runs, size_t count, const GatherPoint& p,
+PhotonEstimate PhotonGatherer::sum_over_runs(const PhotonSoAView& v, const PhotonRun* runs, size_t count, const GatherPoint& p,
                                    GatherScratch& scratch, PhotonQueryStats& stats) const {
     const Material& m = materials_[p.material];
     const bool glossy = m.has_glossy_lobe();
@@ -97,7 +129,8 @@ Vec3 PhotonGatherer::sum_over_runs(const PhotonSoAView& v, const PhotonRun* runs
         return sum_flux_runs(v, runs, count, p.position, p.normal, radius2_, stats.visited, stats.inside);
 
     // Scalar paths: per-photon BSDF (glossy) or the heap (kNN), same run order.
-    Vec3 sum(0.0f);
+    PhotonEstimate sum;
+    auto first_hit = [&](uint32_t j) { return v.first && v.first[j] != 0.0f; };
     uint64_t visited = 0, inside = 0;
     NeighborHeap& heap = scratch.heap;
     if (mode_ == GatherMode::Knn) heap.reset(k_, radius2_);
@@ -112,18 +145,19 @@ Vec3 PhotonGatherer::sum_over_runs(const PhotonSoAView& v, const PhotonRun* runs
             if (mode_ == GatherMode::Knn) {
                 heap.offer(j, d2);
             } else {
-                sum += bsdf_eval(m, p.normal, p.wo, w) * Vec3(v.r[j], v.g[j], v.b[j]);
+                part_of(sum, first_hit(j)) += bsdf_eval(m, p.normal, p.wo, w) * Vec3(v.r[j], v.g[j], v.b[j]);
             }
         }
     }
     if (mode_ == GatherMode::Knn) {
         for (const PhotonNeighbor& nb : heap.items()) {
             Vec3 power(v.r[nb.index], v.g[nb.index], v.b[nb.index]);
+            Vec3& part = part_of(sum, first_hit(nb.index));
             if (glossy) {
                 Vec3 w(v.wx[nb.index], v.wy[nb.index], v.wz[nb.index]);
-                sum += bsdf_eval(m, p.normal, p.wo, w) * power;
+                part += bsdf_eval(m, p.normal, p.wo, w) * power;
             } else {
-                sum += power;
+                part += power;
             }
         }
     }
@@ -132,7 +166,8 @@ Vec3 PhotonGatherer::sum_over_runs(const PhotonSoAView& v, const PhotonRun* runs
     return sum;
 }
 
-Vec3 PhotonGatherer::estimate(const GatherPoint& p, GatherScratch& scratch, PhotonQueryStats& stats) const {
+PhotonEstimate PhotonGatherer::estimate_parts(const GatherPoint& p, GatherScratch& scratch,
+                                              PhotonQueryStats& stats) const {
     const Material& m = materials_[p.material];
     const bool glossy = m.has_glossy_lobe();
     if (grid_) {
@@ -149,11 +184,11 @@ Vec3 PhotonGatherer::estimate(const GatherPoint& p, GatherScratch& scratch, Phot
         return finish(m, sum_over_runs(grid_->view(), runs, count, p, scratch, stats));
     }
     // Trees: photons come from the structure's own traversal.
-    Vec3 sum(0.0f);
+    PhotonEstimate sum;
     auto front = [&](uint32_t i) { return glm::dot(map_.photon(i).wi.unpack(), p.normal) > 0.0f; };
     auto add = [&](uint32_t i) {
         const Photon& ph = map_.photon(i);
-        sum += glossy ? bsdf_eval(m, p.normal, p.wo, ph.incoming()) * ph.power : ph.power;
+        part_of(sum, ph.first_hit()) += glossy ? bsdf_eval(m, p.normal, p.wo, ph.incoming()) * ph.power : ph.power;
     };
     if (mode_ == GatherMode::Radius) {
         auto visit = [&](uint32_t i, float) {
@@ -197,7 +232,8 @@ uint64_t PhotonGatherer::sort_key(const Vec3& x, uint32_t slot) const {
 }
 
 void PhotonGatherer::estimate_group(const glm::ivec3& cell, std::span<const GatherPoint* const> points,
-                                    std::span<Vec3> out, GatherScratch& scratch, PhotonQueryStats& stats) const {
+                                    std::span<PhotonEstimate> out, GatherScratch& scratch,
+                                    PhotonQueryStats& stats) const {
     if (!grid_) throw Error("photon gather", "tile-shared gather needs the hash grid");
     // Fetch the neighbourhood once, run by run, into the local buffer (Algorithm 1).
     PhotonSoA& local = scratch.local;
@@ -208,8 +244,9 @@ void PhotonGatherer::estimate_group(const glm::ivec3& cell, std::span<const Gath
         local_runs.push_back({total, total + r.size()});
         total += r.size();
     });
-    if (local.size() < total) local.resize(total);
     const PhotonSoA& src = grid_->soa();
+    if (local.size() < total || local.has_first_hits() != src.has_first_hits())
+        local.resize(std::max<size_t>(local.size(), total), src.has_first_hits());
     size_t k = 0;
     grid_->for_each_run(cell, radius_, [&](PhotonRun r) {
         const uint32_t dst = local_runs[k++].begin, n = r.size();
@@ -219,6 +256,7 @@ void PhotonGatherer::estimate_group(const glm::ivec3& cell, std::span<const Gath
         copy(src.x, local.x), copy(src.y, local.y), copy(src.z, local.z);
         copy(src.wx, local.wx), copy(src.wy, local.wy), copy(src.wz, local.wz);
         copy(src.r, local.r), copy(src.g, local.g), copy(src.b, local.b);
+        if (src.has_first_hits()) copy(src.first, local.first);
     });
     scratch.fetched += total;
     const PhotonSoAView view = PhotonSoAView::of(local);

@@ -9,6 +9,11 @@
 // in a max-heap and sums those (with the same 1/(π r²), so a full heap under-counts
 // dense regions: the darkening of the paper's Fig. 8).
 //
+// The estimate comes in two parts: photons stored at their path's first hit (direct
+// light, present only in a map built with every-hit storage) and the rest (indirect);
+// each part is summed on its own, so a map without first-hit photons gives a zero
+// direct part and the same indirect part, bit for bit, as a single sum.
+//
 // With the hash grid the sums run over contiguous runs of its structure-of-arrays in a
 // fixed lane order (8 partial sums), so the result depends only on the point, whatever
 // pass order (fused/split) or grouping (tile-shared) is used; estimate_group fetches a
@@ -25,6 +30,13 @@
 namespace gilab {
 
 enum class GatherMode { Radius, Knn };
+
+// Reflected radiance from the photon map, split by the bounce the photons arrived on.
+struct PhotonEstimate {
+    Vec3 direct{0};     // photons stored at their first hit
+    Vec3 indirect{0};   // photons stored at later hits
+    Vec3 total() const { return direct + indirect; }
+};
 
 struct GatherPoint {
     Vec3 position{0};
@@ -45,14 +57,17 @@ class PhotonGatherer {
 public:
     PhotonGatherer(const PhotonMap& map, const std::vector<Material>& materials, GatherMode mode, float radius, size_t k);
 
-    // Σ f_r ΔΦ / (π r²) at p.
-    Vec3 estimate(const GatherPoint& p, GatherScratch& scratch, PhotonQueryStats& stats) const;
+    // Σ f_r ΔΦ / (π r²) at p, by part, and in total.
+    PhotonEstimate estimate_parts(const GatherPoint& p, GatherScratch& scratch, PhotonQueryStats& stats) const;
+    Vec3 estimate(const GatherPoint& p, GatherScratch& scratch, PhotonQueryStats& stats) const {
+        return estimate_parts(p, scratch, stats).total();
+    }
 
     // Tile-shared gather (needs the hash grid): every point must lie in `cell`.
     bool supports_groups() const { return grid_ != nullptr; }
     glm::ivec3 cell_of(const Vec3& x) const;
-    void estimate_group(const glm::ivec3& cell, std::span<const GatherPoint* const> points, std::span<Vec3> out,
-                        GatherScratch& scratch, PhotonQueryStats& stats) const;
+    void estimate_group(const glm::ivec3& cell, std::span<const GatherPoint* const> points,
+                        std::span<PhotonEstimate> out, GatherScratch& scratch, PhotonQueryStats& stats) const;
 
     // A sort key that puts points near each other next to each other. With the hash grid
     // it is the cell's hash for points in the grid (equal keys ⇔ same cell, so sorted
@@ -64,9 +79,9 @@ public:
     float radius() const { return radius_; }
 
 private:
-    Vec3 finish(const Material& m, const Vec3& sum) const;
-    Vec3 sum_over_runs(const PhotonSoAView& v, const PhotonRun* runs, size_t count, const GatherPoint& p,
-                       GatherScratch& scratch, PhotonQueryStats& stats) const;
+    PhotonEstimate finish(const Material& m, const PhotonEstimate& sum) const;
+    PhotonEstimate sum_over_runs(const PhotonSoAView& v, const PhotonRun* runs, size_t count, const GatherPoint& p,
+                                 GatherScratch& scratch, PhotonQueryStats& stats) const;
 
     const PhotonMap& map_;
     const HashGridPhotonMap* grid_ = nullptr;

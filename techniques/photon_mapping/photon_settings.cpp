@@ -5,6 +5,8 @@
 
 namespace gilab {
 
+const char* to_string(PhotonStorage storage) { return storage == PhotonStorage::EveryHit ? "every_hit" : "indirect"; }
+
 PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     PhotonMappingSettings p;
     const std::string& where = s.context();
@@ -15,7 +17,9 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     std::string map = s.get<std::string>("photon_map", to_string(p.photon_map));
     std::string hash_query = s.get<std::string>("hash_query", to_string(p.hash_query));
     std::string pass = s.get<std::string>("pass", "fused");
-    p.tile_shared = s.get<bool>("tile_shared", p.tile_shared);
+    std::string storage = s.get<std::string>("photon_storage", to_string(p.storage));
+    p.tile_shared = parse_tile_share(s.get<nlohmann::json>("tile_shared", to_string(p.tile_shared)), where);
+    p.share_tile = s.get<int>("share_tile", p.share_tile);
     int64_t seed = s.get<int64_t>("seed", int64_t(p.seed));
     p.light_samples = s.get<int>("light_samples", p.light_samples);
     p.max_photon_depth = s.get<int>("max_photon_depth", p.max_photon_depth);
@@ -50,8 +54,17 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
         p.split = true;
     else
         throw Error(where, "setting 'pass' must be 'fused' or 'split', got '" + pass + "'");
-    if (p.tile_shared && p.photon_map != PhotonMapKind::HashGrid)
+    if (storage == "indirect")
+        p.storage = PhotonStorage::Indirect;
+    else if (storage == "every_hit")
+        p.storage = PhotonStorage::EveryHit;
+    else
+        throw Error(where, "setting 'photon_storage' must be 'indirect' or 'every_hit', got '" + storage + "'");
+    const bool shared = p.tile_shared != TileShare::Off;
+    if (shared && p.photon_map != PhotonMapKind::HashGrid)
         throw Error(where, "setting 'tile_shared' needs photon_map=hash_grid (it shares hash-grid cells), got " + map);
+    if (p.share_tile < 1)
+        throw Error(where, "setting 'share_tile' must be at least 1 pixel, got " + std::to_string(p.share_tile));
     if (seed < 0) throw Error(where, "setting 'seed' must not be negative, got " + std::to_string(seed));
     p.seed = uint64_t(seed);
     if (p.light_samples < 0)
@@ -59,6 +72,10 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     if (p.max_photon_depth < 1)
         throw Error(where, "setting 'max_photon_depth' must be at least 1, got " + std::to_string(p.max_photon_depth));
     if (p.tile_size < 1) throw Error(where, "setting 'tile_size' must be at least 1, got " + std::to_string(p.tile_size));
+    if (p.tile_shared == TileShare::Paper && p.tile_size % p.share_tile != 0)
+        throw Error(where, "setting 'tile_shared=paper' needs a tile_size that is a multiple of share_tile (share tiles "
+                           "nest in render tiles), got tile_size " + std::to_string(p.tile_size) + " and share_tile " +
+                               std::to_string(p.share_tile));
     if (match == "nearest")
         p.stereo.match = StereoMatch::Nearest;
     else if (match == "strict")
@@ -80,11 +97,21 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
         if (p.foveation.periphery_photon_stride < 1)
             throw Error(where, "setting 'periphery_photon_stride' must be at least 1, got " +
                                    std::to_string(p.foveation.periphery_photon_stride));
-        if (p.split || p.tile_shared)
-            throw Error(where, "setting 'foveated' needs pass=fused and tile_shared=false (it picks the shading rate per block)");
+        if (p.split || shared)
+            throw Error(where, "setting 'foveated' needs pass=fused and tile_shared=off (it picks the shading rate per block)");
+        if (p.storage == PhotonStorage::EveryHit)
+            throw Error(where, "setting 'foveated' needs photon_storage=indirect (it keeps direct light per pixel by "
+                               "shadow rays and shares only the gathered indirect light within a block)");
         if (p.tile_size % 4 != 0)
             throw Error(where, "setting 'foveated' needs a tile_size that is a multiple of 4 (4×4 shading blocks), got " +
                                    std::to_string(p.tile_size));
+    }
+    if (p.storage == PhotonStorage::EveryHit) {
+        // Direct light comes from the map: no shadow rays at the primary hit.
+        if (p.light_samples != 0 && s.has("light_samples"))
+            throw Error(where, "setting 'light_samples' has no effect with photon_storage=every_hit (direct light comes "
+                               "from the photon map); leave it out or set 0, got " + std::to_string(p.light_samples));
+        p.light_samples = 0;
     }
     if (p.stereo.fill && p.stereo.match != StereoMatch::Nearest) {
         throw Error(where, "setting 'stereo_fill' needs stereo_match=nearest (strict mode reuses only exact matches)");

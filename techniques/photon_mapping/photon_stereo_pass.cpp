@@ -1,6 +1,8 @@
 // The right eye of a reusing stereo render: claims by the left eye's hits
 // (stereo_reuse.hpp), then every right pixel either composes the claiming hit's
-// view-independent shading with its own glossy lobe, or is shaded as an independent eye.
+// view-independent shading with its own glossy lobe, or is shaded as an independent eye
+// (its own gather per hit; with every-hit storage the map's first-hit part is its direct
+// light, as in the left eye).
 #include <mutex>
 #include <optional>
 #include "core/interaction.hpp"
@@ -29,6 +31,8 @@ void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const E
     float* indirect = film.layer("indirect").data.data();
     float* reused_layer = film.add_layer("reused", 1).data.data();
     const Vec3 eye = right.position();
+    // Every-hit storage: direct light is the map's first-hit part, not the light samples.
+    const bool map_direct = s.storage == PhotonStorage::EveryHit;
     std::mutex merge;
     std::atomic<uint64_t> nonfinite{0}, reused{0}, reshaded_glossy{0}, strict_rejected{0}, shaded{0}, filled{0};
 
@@ -66,14 +70,20 @@ void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const E
                 if (from_left) {
                     const PrimaryHit& h = kept.hits[source];
                     const Material& m = scene_.materials()[h.point.material];
-                    if (s.stereo.reshade) {
+                    if (s.stereo.reshade && map_direct && !m.has_glossy_lobe()) {
+                        // Every-hit storage, Lambertian: the left eye's light is view-independent.
+                        Ld = load(left_direct, source);
+                        Li = load(left_indirect, source);
+                    } else if (s.stereo.reshade) {
                         // View-independent parts from the left eye; the glossy lobe for this eye.
                         const Vec3 wo = glm::normalize(eye - h.point.position);
                         Ld = direct_radiance(m, h, wo, kept.samples_of(source));
                         if (m.has_glossy_lobe()) {
                             GatherPoint p = h.point;
                             p.wo = wo;
-                            Li = gatherer.estimate(p, scratch, qs);
+                            const PhotonEstimate e = gatherer.estimate_parts(p, scratch, qs);
+                            Li = e.indirect;
+                            if (map_direct) Ld += e.direct;
                             ++n_glossy;
                         } else {
                             Li = load(left_indirect, source);
@@ -91,7 +101,9 @@ void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const E
                     Rng rng = light_sample_stream(s.seed, &left, own->position, pixel, 1);
                     sample_direct_light(shading, *own, rng, samples, ph);
                     Ld = direct_radiance(m, ph, own->wo, samples);
-                    Li = gatherer.estimate(ph.point, scratch, qs);
+                    const PhotonEstimate e = gatherer.estimate_parts(ph.point, scratch, qs);
+                    Li = e.indirect;
+                    if (map_direct) Ld += e.direct;
                     ++n_shaded;
                 }
                 write_pixel(direct, pixel, finite_or_zero(Ld, nonfinite));

@@ -1,5 +1,6 @@
 #include "techniques/photon_mapping/photon_technique.hpp"
 
+#include <algorithm>
 #include "core/error.hpp"
 #include "core/format.hpp"
 #include "techniques/photon_mapping/photon_passes.hpp"
@@ -30,10 +31,12 @@ void PhotonMappingTechnique::trace_and_build() {
     PhotonTraceSettings ts;
     ts.emitted = settings_.photons;
     ts.max_depth = settings_.max_photon_depth;
-    ts.first_stored_hit = 2;
+    ts.first_stored_hit = settings_.storage == PhotonStorage::EveryHit ? 1 : 2;
     ts.seed = settings_.seed;
     PhotonTraceResult traced = trace_photons(scene_.tracer(), scene_.frame(), scene_.materials(), scene_.lights(), ts);
     const size_t stored = traced.photons.size();
+    const size_t first_hits = size_t(
+        std::count_if(traced.photons.begin(), traced.photons.end(), [](const Photon& p) { return p.first_hit(); }));
     Stopwatch build;
     periphery_map_.reset();
     if (settings_.foveation.enabled) {
@@ -60,6 +63,7 @@ void PhotonMappingTechnique::trace_and_build() {
     stats_.set("photon_build_ms", build.elapsed_ms());
     stats_.set("photons_emitted", double(traced.emitted));
     stats_.set("photons_stored", double(stored));
+    stats_.set("photons_stored_first_hit", double(first_hits));
     stats_.set("photon_rays", double(traced.rays));
     stats_.set("photon_map_bytes", double(map_->memory_bytes()));
     if (auto* grid = dynamic_cast<const HashGridPhotonMap*>(map_.get())) stats_.set("hash_cells", double(grid->cell_count()));
@@ -107,6 +111,8 @@ void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& fil
         film.metadata["radius"] = format_number(settings_.radius);
         film.metadata["gather"] = settings_.gather == GatherMode::Knn ? "knn" : "radius";
         film.metadata["photon_map"] = to_string(settings_.photon_map);
+        film.metadata["photon_storage"] = to_string(settings_.storage);
+        film.metadata["tile_shared"] = to_string(settings_.tile_shared);
         film.metadata["seed"] = std::to_string(settings_.seed);
         if (stereo) film.metadata["stereo_reuse"] = reuse ? to_string(settings_.stereo.match) : "off";
         film.metadata["config_hash"] = config_hash_;
@@ -117,7 +123,8 @@ void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& fil
     for (Film& film : films) film.metadata["render_time_seconds"] = format_number(ms / 1000.0);
     // Per-frame figures replace the previous frame's.
     for (const char* key : {"fused_ms", "trace_pass_ms", "sort_ms", "gather_pass_ms", "nonfinite_pixels", "tile_groups",
-                            "tile_grouped_hits", "tile_fetched_photons", "left_ms", "right_ms",
+                            "tile_grouped_hits", "tile_fetched_photons", "share_tiles_qualified",
+                            "share_tiles_mixed", "left_ms", "right_ms",
                             "claim_ms", "right_pass_ms", "reuse_left_hits", "reuse_back_side", "reuse_outside",
                             "reuse_occluded", "reuse_candidates", "reuse_claimed_pixels", "reuse_depth_conflicts",
                             "reuse_strict_rejected", "reused_pixels", "reuse_crack_filled", "reuse_fraction", "reuse_reshaded_glossy",
@@ -134,7 +141,7 @@ void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& fil
 void register_photon_mapping(TechniqueRegistry& registry) {
     registry.add({"photon",
                   "photon mapping (P1): hash-grid / kd-tree / nanoflann photon map, radius or kNN gather, "
-                  "fused or split passes, tile-shared gather",
+                  "indirect or every-hit photon storage, fused or split passes, tile-shared gather",
                   [] { return std::make_unique<PhotonMappingTechnique>(); }});
 }
 

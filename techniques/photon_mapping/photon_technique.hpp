@@ -1,22 +1,35 @@
 #pragma once
 // Photon mapping as in P1: photons traced from the lights into a photon map (hash grid,
-// Jensen kd-tree or nanoflann), then per pixel one primary ray, direct light by shadow
-// rays (next-event estimation, `light_samples` per hit) and indirect light by density
-// estimation over the photon map at the primary hit (photon_gather.hpp).
-//
-// Layers: color (global = direct + indirect), direct (emission seen directly + one-bounce
-// lighting by shadow rays), indirect (two or more bounces: the map stores photons from
-// their second surface hit on, i.e. light that has bounced at least once) — the same
-// split as the path tracer's layers.
+// Jensen kd-tree or nanoflann), then per pixel one primary ray and density estimation
+// over the photon map at the primary hit (photon_gather.hpp). Where direct light comes
+// from depends on `photon_storage`:
+// * indirect (default): the map stores photons from their second surface hit on, and
+//   direct light is computed by shadow rays (next-event estimation, `light_samples` per
+//   hit). Layers: direct = emission seen directly + one-bounce lighting by shadow rays;
+//   indirect = the map's estimate (light that has bounced at least once).
+// * every_hit (P1's photon map): a copy is stored at every non-specular hit, the first
+//   one included, so the map holds one more photon for every photon that reaches a
+//   surface; direct light comes from the map too, with no shadow rays or light samples at
+//   the primary hit (light_samples must be left out or 0). Each stored photon records its hit index, and the estimate is
+//   split by it: direct = emission seen directly + the first-hit photons' estimate;
+//   indirect = the later-hit photons' estimate, the same quantity as in indirect mode.
+// Either way color = direct + indirect, the same split as the path tracer's layers.
 //
 // Settings: photons (emitted, 256·256), radius (0.05), gather (radius | knn), k (128),
 // photon_map (hash_grid | kd_tree | nanoflann), hash_query (runs9 | cells27),
-// pass (fused: trace and gather per pixel in one loop | split: all primary hits into a
-// buffer first, then a gather pass over the hits sorted by cell; bit-identical),
-// tile_shared (false | true: hits sharing a hash cell fetch that neighbourhood once and
-// are all evaluated against it; hash grid only; bit-identical), seed (1),
-// light_samples (1), max_photon_depth (8: surface hits along a photon path),
-// tile_size (16). Primary rays go through pixel centres.
+// photon_storage (indirect | every_hit), pass (fused: trace and gather per pixel in one
+// loop | split: all primary hits into a buffer first, then a gather pass; bit-identical),
+// tile_shared (off | paper | cell_groups; tile_share.hpp; hash grid only; bit-identical:
+// paper = P1's Algorithm 1, a share_tile × share_tile screen tile fetches its cell's
+// neighbourhood once only if all its hits lie in one hash cell, else each hit gathers
+// alone; cell_groups = hits sharing a cell share one fetch, within a render tile (fused)
+// or across the image (split, hits sorted by cell). The JSON booleans of older settings
+// files still work: false = off, true = cell_groups), share_tile (8 pixels: P1 does not
+// give its thread-group size; tile_size must be a multiple of it with tile_shared=paper),
+// seed (1), light_samples (1), max_photon_depth (8: surface hits along a photon path),
+// tile_size (16). Primary rays go through pixel centres. With pass=split the gather pass
+// walks the hits sorted by cell, except with tile_shared=paper, where it walks the share
+// tiles (the paper's hybrid kernel: one thread group per tile).
 //
 // Stereo (a two-view render): the right eye draws its light samples from the stream of
 // the left pixel that sees the same point, so both eyes show the same noise on a surface
@@ -27,12 +40,17 @@
 // footprints), stereo_reshade (true: re-evaluate the glossy lobe for the right eye;
 // false: copy the left colour, the paper's behaviour), stereo_fill (false: true fills
 // one-pixel reprojection cracks from neighbouring claims, nearest mode only). The right
-// film gets a "reused" layer (1 where the pixel came from the left eye).
+// film gets a "reused" layer (1 where the pixel came from the left eye); its unclaimed
+// pixels gather per hit whatever tile_shared says. With photon_storage=every_hit a
+// reshaded glossy pixel re-gathers both parts of the estimate for the right eye's
+// direction, a Lambertian one copies the left eye's direct and indirect light.
 //
 // Foveation (foveation.hpp): foveated (false), fovea_angle (10 degrees),
 // periphery_photon_stride (4), gaze_yaw / gaze_pitch (0 degrees: the eye's forward axis).
-// Needs pass=fused, tile_shared=false and a tile_size that is a multiple of 4. With
-// stereo_reuse the right eye's unclaimed pixels are gathered at the full rate.
+// Needs pass=fused, tile_shared=off, photon_storage=indirect (it keeps direct light per
+// pixel by shadow rays and shares only gathered indirect light) and a tile_size that is
+// a multiple of 4. With stereo_reuse the right eye's unclaimed pixels are gathered at the
+// full rate.
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -44,10 +62,15 @@
 #include "techniques/photon_mapping/foveation.hpp"
 #include "techniques/photon_mapping/photon_gather.hpp"
 #include "techniques/photon_mapping/stereo_reuse.hpp"
+#include "techniques/photon_mapping/tile_share.hpp"
 #include "core/traced_scene.hpp"
 #include "techniques/technique.hpp"
 
 namespace gilab {
+
+// Which photon copies the map keeps (see the header comment).
+enum class PhotonStorage { Indirect, EveryHit };
+const char* to_string(PhotonStorage storage);  // "indirect", "every_hit"
 
 struct PhotonMappingSettings {
     uint64_t photons = 256 * 256;
@@ -57,7 +80,9 @@ struct PhotonMappingSettings {
     PhotonMapKind photon_map = PhotonMapKind::HashGrid;
     HashQuery hash_query = HashQuery::Runs9;
     bool split = false;
-    bool tile_shared = false;
+    PhotonStorage storage = PhotonStorage::Indirect;
+    TileShare tile_shared = TileShare::Off;
+    int share_tile = 8;  // pixels square: the paper's thread-group tile (its size is not given)
     uint64_t seed = 1;
     int light_samples = 1;
     int max_photon_depth = 8;

@@ -35,6 +35,7 @@ uint64_t trace_one(const RayTracer& tracer, const SceneFrame& frame, const std::
             p.power = flux;
             p.wi = PackedDirection::pack(si.wo);
             p.normal = PackedDirection::pack(si.geometric_normal);
+            p.set_hit_index(hit_index);
             out.push_back(p);
             stored = true;
         }

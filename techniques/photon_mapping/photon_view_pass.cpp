@@ -1,6 +1,6 @@
-// One eye of the photon technique: primary rays, next-event estimation and the photon
-// gather, fused per tile, split into a trace and a cell-sorted gather pass, tile-shared,
-// or foveated.
+// One eye of the photon technique: primary rays, next-event estimation (indirect
+// storage only) and the photon gather, fused per tile or split into a trace and a gather
+// pass, per hit, tile-shared (tile_share.hpp) or foveated.
 #include <algorithm>
 #include <mutex>
 #include <optional>
@@ -42,7 +42,9 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
     float* direct = film.layer("direct").data.data();
     float* indirect = film.layer("indirect").data.data();
     std::mutex merge;
-    std::atomic<uint64_t> nonfinite{0}, groups{0}, grouped_hits{0}, fetched{0};
+    std::atomic<uint64_t> nonfinite{0};
+    uint64_t fetched = 0;             // under `merge`
+    TileShareCounts share_counts;     // under `merge`
     KeptHits* keep = options.keep;
     if (keep) {
         // Kept from frame to frame: every pixel overwrites its entry, so no clearing.
@@ -51,8 +53,9 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
         keep->samples.resize(film.pixel_count() * keep->per_pixel);
     }
 
-    // Primary ray through (px, py), emission and next-event estimation for `pixel`; the
-    // hit is returned for the gather and its direct radiance written.
+    // Primary ray through (px, py), emission and next-event estimation (no light samples
+    // with every-hit storage) for `pixel`; the hit is returned for the gather and its
+    // direct radiance written.
     auto trace_pixel = [&](float px, float py, uint32_t pixel) {
         thread_local std::vector<LightSampleRecord> scratch_samples;
         HitRecord rec;
@@ -84,34 +87,61 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
         return rec;
     };
     auto pixel_index = [&](int x, int y) { return uint32_t(size_t(y) * size_t(width) + size_t(x)); };
-    auto write_indirect = [&](uint32_t pixel, Vec3 v) { write_pixel(indirect, pixel, finite_or_zero(v, nonfinite)); };
-    // Gathers hits[items[b..e).slot]: runs of hits sharing a cell together (Algorithm 1)
-    // when `shared`, else one by one.
-    auto gather_sorted = [&](const std::vector<HitRecord>& hits, const std::vector<SortItem>& items, size_t b, size_t e,
-                             GatherScratch& scratch, PhotonQueryStats& qs, bool shared) {
-        std::vector<const GatherPoint*> points;
-        std::vector<Vec3> out;
-        uint64_t local_groups = 0, local_grouped = 0;
-        for (size_t i = b; i < e;) {
-            size_t j = i + 1;
-            if (shared)
-                while (j < e && items[j].same_group(items[i])) ++j;
-            if (j - i >= 2) {
-                points.clear();
-                for (size_t t = i; t < j; ++t) points.push_back(&hits[items[t].slot].point);
-                out.resize(points.size());
-                gatherer.estimate_group(gatherer.cell_of(points[0]->position), points, out, scratch, qs);
-                for (size_t t = i; t < j; ++t) write_indirect(hits[items[t].slot].pixel, out[t - i]);
-                ++local_groups;
-                local_grouped += j - i;
-            } else {
-                const HitRecord& h = hits[items[i].slot];
-                write_indirect(h.pixel, gatherer.estimate(h.point, scratch, qs));
-            }
-            i = j;
+    // The map's estimate for a pixel: the indirect part into the indirect layer and, with
+    // every-hit storage, the direct part added to what the primary hit wrote (emission).
+    const bool map_direct = s.storage == PhotonStorage::EveryHit;
+    auto write_gather = [&](uint32_t pixel, const PhotonEstimate& e) {
+        write_pixel(indirect, pixel, finite_or_zero(e.indirect, nonfinite));
+        if (map_direct) {
+            const Vec3 seen(direct[3 * pixel], direct[3 * pixel + 1], direct[3 * pixel + 2]);
+            write_pixel(direct, pixel, finite_or_zero(seen + e.direct, nonfinite));
         }
-        groups += local_groups;
-        grouped_hits += local_grouped;
+    };
+    auto merge_counts = [&](const GatherScratch& scratch, const PhotonQueryStats& qs, const TileShareCounts& tc) {
+        std::lock_guard<std::mutex> lock(merge);
+        fetched += scratch.fetched;
+        query_stats.merge(qs);
+        share_counts.merge(tc);
+    };
+    // Gathers the sorted hits items[b..e): per hit, or (cell_groups) runs of hits sharing a
+    // cell together.
+    auto gather_sorted = [&](const std::vector<HitRecord>& hits, const std::vector<SortItem>& items, size_t b, size_t e,
+                             GatherScratch& scratch, PhotonQueryStats& qs, TileShareCounts& tc) {
+        if (s.tile_shared != TileShare::CellGroups) {
+            for (size_t i = b; i < e; ++i) {
+                const HitRecord& h = hits[items[i].slot];
+                write_gather(h.pixel, gatherer.estimate_parts(h.point, scratch, qs));
+            }
+            return;
+        }
+        thread_local std::vector<uint64_t> keys;
+        thread_local std::vector<const GatherPoint*> points;
+        thread_local std::vector<PhotonEstimate> out;
+        keys.clear(), points.clear();
+        for (size_t i = b; i < e; ++i) {
+            keys.push_back(items[i].key);
+            points.push_back(&hits[items[i].slot].point);
+        }
+        out.resize(points.size());
+        gather_cell_groups(gatherer, keys, points, out, scratch, qs, tc);
+        for (size_t i = b; i < e; ++i) write_gather(hits[items[i].slot].pixel, out[i - b]);
+    };
+    // Algorithm 1 over one share tile t (hit_of(x, y) gives the hit of image pixel (x, y)).
+    auto gather_share_tile = [&](const Tile& t, const auto& hit_of, GatherScratch& scratch, PhotonQueryStats& qs,
+                                 TileShareCounts& tc) {
+        thread_local std::vector<const GatherPoint*> points;
+        thread_local std::vector<PhotonEstimate> out;
+        points.clear();
+        for (int y = t.y0; y < t.y1; ++y)
+            for (int x = t.x0; x < t.x1; ++x) {
+                const HitRecord& h = hit_of(x, y);
+                points.push_back(h.valid ? &h.point : nullptr);
+            }
+        out.assign(points.size(), PhotonEstimate{});
+        gather_tile_paper(gatherer, points, out, scratch, qs, tc);
+        size_t i = 0;
+        for (int y = t.y0; y < t.y1; ++y)
+            for (int x = t.x0; x < t.x1; ++x, ++i) write_gather(pixel_index(x, y), out[i]);
     };
     // Hits in cell order (then by slot: a total order, so the parallel sort is
     // deterministic).
@@ -148,22 +178,28 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
                 for (int sy = by; sy < by1; sy += b)
                     for (int sx = bx; sx < bx1; sx += b) {
                         std::optional<HitRecord> gathered;
-                        Vec3 gathered_light(0.0f);
+                        PhotonEstimate gathered_light;
                         for (int y = sy; y < std::min(sy + b, by1); ++y)
                             for (int x = sx; x < std::min(sx + b, bx1); ++x) {
                                 HitRecord rec = trace_pixel(float(x) + 0.5f, float(y) + 0.5f, pixel_index(x, y));
                                 if (!rec.valid) {
-                                    write_indirect(rec.pixel, Vec3(0.0f));
+                                    write_gather(rec.pixel, PhotonEstimate{});
                                 } else if (gathered && shares_gather(*gathered, rec)) {
-                                    write_indirect(rec.pixel, gathered_light);
+                                    write_gather(rec.pixel, gathered_light);
                                 } else {
-                                    const Vec3 v = g.estimate(rec.point, scratch, qs);
-                                    write_indirect(rec.pixel, v);
+                                    const PhotonEstimate v = g.estimate_parts(rec.point, scratch, qs);
+                                    write_gather(rec.pixel, v);
                                     if (!gathered) gathered = rec, gathered_light = v;
                                 }
                             }
                     }
             }
+    };
+    // The share tiles (image-aligned, share_tile pixels square) inside a region.
+    auto for_each_share_tile = [&](const Tile& region, const auto& fn) {
+        const int n = s.share_tile;
+        for (int y = region.y0; y < region.y1; y += n)
+            for (int x = region.x0; x < region.x1; x += n) fn(Tile{x, y, std::min(x + n, region.x1), std::min(y + n, region.y1)});
     };
 
     if (!s.split) {
@@ -171,14 +207,28 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
         parallel_for_tiles(width, height, s.tile_size, [&](const Tile& tile) {
             GatherScratch scratch;
             PhotonQueryStats qs;
+            TileShareCounts tc;
             if (s.foveation.enabled) {
                 shade_foveated_tile(tile, scratch, qs);
-            } else if (!s.tile_shared) {
+            } else if (s.tile_shared == TileShare::Off) {
                 for (int y = tile.y0; y < tile.y1; ++y)
                     for (int x = tile.x0; x < tile.x1; ++x) {
                         HitRecord rec = trace_pixel(float(x) + 0.5f, float(y) + 0.5f, pixel_index(x, y));
-                        write_indirect(rec.pixel, rec.valid ? gatherer.estimate(rec.point, scratch, qs) : Vec3(0.0f));
+                        write_gather(rec.pixel, rec.valid ? gatherer.estimate_parts(rec.point, scratch, qs) : PhotonEstimate{});
                     }
+            } else if (s.tile_shared == TileShare::Paper) {
+                // One thread group per share tile (tile_size is a multiple of share_tile):
+                // trace its pixels, then Algorithm 1.
+                const size_t tw = size_t(tile.x1 - tile.x0);
+                std::vector<HitRecord> tile_hits(tw * size_t(tile.y1 - tile.y0));
+                auto slot = [&](int x, int y) { return size_t(y - tile.y0) * tw + size_t(x - tile.x0); };
+                auto hit_of = [&](int x, int y) -> const HitRecord& { return tile_hits[slot(x, y)]; };
+                for_each_share_tile(tile, [&](const Tile& t) {
+                    for (int y = t.y0; y < t.y1; ++y)
+                        for (int x = t.x0; x < t.x1; ++x)
+                            tile_hits[slot(x, y)] = trace_pixel(float(x) + 0.5f, float(y) + 0.5f, pixel_index(x, y));
+                    gather_share_tile(t, hit_of, scratch, qs, tc);
+                });
             } else {
                 // Trace the tile, then group its hits by cell.
                 std::vector<HitRecord> tile_hits;
@@ -189,15 +239,13 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
                         if (rec.valid)
                             valid.push_back(uint32_t(tile_hits.size()));
                         else
-                            write_indirect(rec.pixel, Vec3(0.0f));
+                            write_gather(rec.pixel, PhotonEstimate{});
                         tile_hits.push_back(rec);
                     }
                 std::vector<SortItem> items = sort_items(tile_hits, valid);
-                gather_sorted(tile_hits, items, 0, items.size(), scratch, qs, true);
+                gather_sorted(tile_hits, items, 0, items.size(), scratch, qs, tc);
             }
-            fetched += scratch.fetched;
-            std::lock_guard<std::mutex> lock(merge);
-            query_stats.merge(qs);
+            merge_counts(scratch, qs, tc);
         });
         frame_stats.add("fused_ms", watch.elapsed_ms());
     } else {
@@ -212,47 +260,59 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
                 }
         });
         frame_stats.add("trace_pass_ms", trace_watch.elapsed_ms());
-        // Pass 2: gather in cell order for memory coherence, results written by pixel.
-        Stopwatch sort_watch;
-        std::vector<uint32_t> valid;
-        valid.reserve(hits.size());
-        for (const HitRecord& h : hits) {
-            if (h.valid)
-                valid.push_back(h.pixel);
-            else
-                write_indirect(h.pixel, Vec3(0.0f));
-        }
-        std::vector<SortItem> items = sort_items(hits, valid);
-        frame_stats.add("sort_ms", sort_watch.elapsed_ms());
         Stopwatch gather_watch;
-        // Chunks end on cell boundaries so a tile-shared group is never split.
-        std::vector<size_t> bounds{0};
-        const size_t chunk = 1024;
-        for (size_t i = chunk; i < items.size(); i += chunk) {
-            if (s.tile_shared)
-                while (i < items.size() && items[i].same_group(items[i - 1])) ++i;
-            if (i >= items.size()) break;
-            bounds.push_back(i);
+        if (s.tile_shared == TileShare::Paper) {
+            // Pass 2 as the paper's gather kernel: one thread group per share tile.
+            auto hit_of = [&](int x, int y) -> const HitRecord& { return hits[pixel_index(x, y)]; };
+            parallel_for_tiles(width, height, s.share_tile, [&](const Tile& t) {
+                GatherScratch scratch;
+                PhotonQueryStats qs;
+                TileShareCounts tc;
+                gather_share_tile(t, hit_of, scratch, qs, tc);
+                merge_counts(scratch, qs, tc);
+            });
+        } else {
+            // Pass 2: gather in cell order for memory coherence, results written by pixel.
+            Stopwatch sort_watch;
+            std::vector<uint32_t> valid;
+            valid.reserve(hits.size());
+            for (const HitRecord& h : hits) {
+                if (h.valid)
+                    valid.push_back(h.pixel);
+                else
+                    write_gather(h.pixel, PhotonEstimate{});
+            }
+            std::vector<SortItem> items = sort_items(hits, valid);
+            frame_stats.add("sort_ms", sort_watch.elapsed_ms());
+            // Chunks end on cell boundaries so a cell group is never split.
+            std::vector<size_t> bounds{0};
+            const size_t chunk = 1024;
+            for (size_t i = chunk; i < items.size(); i += chunk) {
+                if (s.tile_shared == TileShare::CellGroups)
+                    while (i < items.size() && items[i].same_group(items[i - 1])) ++i;
+                if (i >= items.size()) break;
+                bounds.push_back(i);
+            }
+            bounds.push_back(items.size());
+            parallel_for(bounds.size() - 1, 1, [&](size_t cb, size_t ce) {
+                GatherScratch scratch;
+                PhotonQueryStats qs;
+                TileShareCounts tc;
+                for (size_t c = cb; c < ce; ++c) gather_sorted(hits, items, bounds[c], bounds[c + 1], scratch, qs, tc);
+                merge_counts(scratch, qs, tc);
+            });
         }
-        bounds.push_back(items.size());
-        parallel_for(bounds.size() - 1, 1, [&](size_t cb, size_t ce) {
-            GatherScratch scratch;
-            PhotonQueryStats qs;
-            for (size_t c = cb; c < ce; ++c)
-                gather_sorted(hits, items, bounds[c], bounds[c + 1], scratch, qs, s.tile_shared);
-            fetched += scratch.fetched;
-            std::lock_guard<std::mutex> lock(merge);
-            query_stats.merge(qs);
-        });
         frame_stats.add("gather_pass_ms", gather_watch.elapsed_ms());
     }
 
     float* color = film.layer("color").data.data();
     for (size_t i = 0; i < 3 * film.pixel_count(); ++i) color[i] = direct[i] + indirect[i];
     frame_stats.add("nonfinite_pixels", double(nonfinite.load()));
-    frame_stats.add("tile_groups", double(groups.load()));
-    frame_stats.add("tile_grouped_hits", double(grouped_hits.load()));
-    frame_stats.add("tile_fetched_photons", double(fetched.load()));
+    frame_stats.add("tile_groups", double(share_counts.groups));
+    frame_stats.add("tile_grouped_hits", double(share_counts.grouped_hits));
+    frame_stats.add("tile_fetched_photons", double(fetched));
+    frame_stats.add("share_tiles_qualified", double(share_counts.tiles_qualified));
+    frame_stats.add("share_tiles_mixed", double(share_counts.tiles_mixed));
 }
 
 }  // namespace gilab
