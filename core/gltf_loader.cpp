@@ -15,7 +15,9 @@
 //    JOINTS_1/WEIGHTS_1 are ignored (four influences per vertex) with a warning.
 //  * Morph targets are not supported: the base shape is used and a warning says so.
 //  * Every accessor and index is range-checked: a bad file throws Error, never reads
-//    outside its buffers.
+//    outside its buffers. The file itself is checked before tinygltf reads it
+//    (core/gltf_checks.hpp), and every allocation sized by the file is checked against
+//    the memory budget first.
 #include <tiny_gltf.h>
 
 #include <cstring>
@@ -24,6 +26,9 @@
 #include <set>
 #include <sstream>
 #include "core/error.hpp"
+#include "core/gltf_checks.hpp"
+#include "core/input_file.hpp"
+#include "core/memory_budget.hpp"
 #include "core/mesh_loaders.hpp"
 #include "core/skin.hpp"
 
@@ -37,6 +42,7 @@ struct Context {
     const tinygltf::Model& model;
     std::string file;
     Scene& scene;
+    uint64_t input_bytes = 0;  // the file and its buffers
     void warn(const std::string& message) {
         const std::string w = file + ": " + message;
         for (const auto& existing : scene.warnings)
@@ -75,7 +81,13 @@ AccessorView view_accessor(const Context& ctx, int index, const std::string& wha
     v.count = a.count;
     v.component_type = a.componentType;
     v.normalized = a.normalized;
-    if (a.bufferView < 0) return v;  // zeros, per the specification
+    const size_t element = size_t(v.components) * size_t(csize);
+    if (a.bufferView < 0) {
+        // All zeros, per the specification. Without sparse accessors such data carries
+        // nothing, and one larger than the whole input can only be a corrupt count.
+        MemoryBudget::check_count(v.count, element, ctx.input_bytes, element, label + " count (no buffer view)", ctx.file);
+        return v;
+    }
     if (size_t(a.bufferView) >= m.bufferViews.size())
         throw Error(ctx.file, label + ": buffer view " + std::to_string(a.bufferView) + " is out of range");
     const tinygltf::BufferView& bv = m.bufferViews[size_t(a.bufferView)];
@@ -85,7 +97,6 @@ AccessorView view_accessor(const Context& ctx, int index, const std::string& wha
     if (bv.byteOffset > buffer.data.size() || bv.byteLength > buffer.data.size() - bv.byteOffset)
         throw Error(ctx.file, label + ": buffer view " + std::to_string(a.bufferView) +
                                   " reaches past the end of its buffer (truncated file?)");
-    const size_t element = size_t(v.components) * size_t(csize);
     v.stride = bv.byteStride ? bv.byteStride : element;
     if (v.stride < element) throw Error(ctx.file, label + ": byte stride is smaller than one element");
     if (v.count > 0) {
@@ -135,6 +146,8 @@ std::vector<float> read_floats(const Context& ctx, int index, int components, co
     if (v.components != components)
         throw Error(ctx.file, accessor_label(index, what) + ": has " + std::to_string(v.components) +
                                   " components per element, expected " + std::to_string(components));
+    MemoryBudget::check(MemoryBudget::times(v.count, size_t(components) * sizeof(float)),
+                        accessor_label(index, what) + " (" + std::to_string(v.count) + " elements)", ctx.file);
     std::vector<float> out(v.count * size_t(components), 0.0f);
     if (!v.data) return out;
     const int csize = tinygltf::GetComponentSizeInBytes(uint32_t(v.component_type));
@@ -148,6 +161,8 @@ std::vector<float> read_floats(const Context& ctx, int index, int components, co
 std::vector<uint32_t> read_indices(const Context& ctx, int index, const std::string& what) {
     AccessorView v = view_accessor(ctx, index, what);
     if (v.components != 1) throw Error(ctx.file, accessor_label(index, what) + ": indices must be scalars");
+    MemoryBudget::check(MemoryBudget::times(v.count, sizeof(uint32_t) + 16),  // and the triangles they make
+                        accessor_label(index, what) + " (" + std::to_string(v.count) + " indices)", ctx.file);
     std::vector<uint32_t> out(v.count, 0);
     if (!v.data) return out;
     for (size_t i = 0; i < v.count; ++i) {
@@ -194,6 +209,22 @@ Mat4 node_local_matrix(const tinygltf::Node& n) {
                                          float(n.rotation[2])));
     if (n.scale.size() == 3) t.scale = Vec3(n.scale[0], n.scale[1], n.scale[2]);
     return t.matrix();
+}
+
+// Values are used in single precision: 1e300 would become infinity on the way.
+void check_node_transform(const std::string& file, int index, const tinygltf::Node& n) {
+    const std::pair<const char*, const std::vector<double>*> parts[] = {
+        {"matrix", &n.matrix}, {"translation", &n.translation}, {"rotation", &n.rotation}, {"scale", &n.scale}};
+    for (const auto& [name, values] : parts)
+        for (size_t k = 0; k < values->size(); ++k) {
+            const double v = (*values)[k];
+            if (!std::isfinite(v) || std::abs(v) > double(std::numeric_limits<float>::max())) {
+                std::ostringstream text;
+                text << v;
+                throw Error(file, "/nodes/" + std::to_string(index) + "/" + name + "/" + std::to_string(k) + ": " +
+                                      text.str() + " is out of range (single precision holds at most ±3.4e38)");
+            }
+        }
 }
 
 Transform node_local_transform(const tinygltf::Node& n) {
@@ -552,6 +583,17 @@ void load_animations(Context& ctx, const std::vector<int>& gltf_to_node) {
 
 bool load_image_tolerant(tinygltf::Image* image, const int index, std::string* err, std::string* warn, int w, int h,
                          const unsigned char* bytes, int size, void* user) {
+    // Decoding allocates what the image header says; a texture too large for the
+    // memory budget is skipped like an undecodable one.
+    if (auto dims = encoded_image_size(bytes, size_t(std::max(size, 0)))) {
+        const uint64_t decoded = MemoryBudget::times(uint64_t(dims->first) * dims->second, 8);
+        if (decoded > MemoryBudget::limit()) {
+            if (warn)
+                *warn += "image " + std::to_string(index) + " (" + std::to_string(dims->first) + "x" +
+                         std::to_string(dims->second) + ") would exceed the memory limit when decoded and is ignored\n";
+            return true;
+        }
+    }
     std::string decode_error;
     if (tinygltf::LoadImageData(image, index, &decode_error, warn, w, h, bytes, size, user)) return true;
     // Textures only tint materials here; an undecodable image is not fatal.
@@ -570,24 +612,28 @@ void add_lines(Context& ctx, const std::string& text) {
 
 Scene load_gltf(const fs::path& path) {
     const std::string file = path.string();
-    std::error_code ec;
-    if (!fs::is_regular_file(path, ec)) throw Error(file, "file not found");
-    std::string ext = path.extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const std::string bytes = read_input_file(path);
+    const GltfInput input = check_gltf_file(path, bytes);
+    if (bytes.size() > UINT32_MAX) throw Error(file, "larger than 4 GiB, which glTF readers do not support");
 
     tinygltf::Model model;
     tinygltf::TinyGLTF reader;
     reader.SetImageLoader(load_image_tolerant, nullptr);
+    use_checked_file_access(reader);
     std::string err, warn;
-    const bool ok = ext == ".glb" ? reader.LoadBinaryFromFile(&model, &err, &warn, file)
-                                  : reader.LoadASCIIFromFile(&model, &err, &warn, file);
+    const std::string base_dir = path.parent_path().string();
+    const bool ok = input.binary ? reader.LoadBinaryFromMemory(&model, &err, &warn,
+                                                               reinterpret_cast<const unsigned char*>(bytes.data()),
+                                                               unsigned(bytes.size()), base_dir)
+                                 : reader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), unsigned(bytes.size()),
+                                                              base_dir);
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
     if (!ok) throw Error(file, "malformed glTF: " + (err.empty() ? std::string("could not be parsed") : err));
 
     Scene scene;
     scene.name = path.stem().string();
     scene.source = file;
-    Context ctx{model, file, scene};
+    Context ctx{model, file, scene, input.input_bytes};
     add_lines(ctx, warn);
     if (!err.empty()) add_lines(ctx, err);
 
@@ -624,7 +670,12 @@ Scene load_gltf(const fs::path& path) {
         SceneNode node;
         node.name = gn.name.empty() ? "node" + std::to_string(gi) : gn.name;
         node.parent = parent;
+        check_node_transform(file, gi, gn);
         node.local = node_local_transform(gn);
+        if (!is_finite(node.local.translation) || !is_finite(node.local.scale) ||
+            !std::isfinite(glm::length(node.local.rotation)))
+            throw Error(file, "node " + std::to_string(gi) + " ('" + node.name +
+                                  "'): its matrix does not decompose into a finite translation, rotation and scale");
         const int index = int(scene.nodes.size());
         gltf_to_node[size_t(gi)] = index;
         gltf_world[size_t(gi)] = parent_world * node_local_matrix(gn);
@@ -735,7 +786,9 @@ Scene load_gltf(const fs::path& path) {
             scene.lights.push_back(light);
         }
         if (gn.camera >= 0 && !scene.camera && size_t(gn.camera) < model.cameras.size() &&
-            model.cameras[size_t(gn.camera)].type == "perspective") {
+            model.cameras[size_t(gn.camera)].type == "perspective" &&
+            model.cameras[size_t(gn.camera)].perspective.yfov > 0 && model.cameras[size_t(gn.camera)].perspective.yfov < kPi &&
+            is_finite(Vec3(gltf_world[gi][3]))) {
             const Mat4& w = gltf_world[gi];
             SceneCamera cam;
             cam.position = Vec3(w * Vec4(0, 0, 0, 1));
@@ -750,6 +803,7 @@ Scene load_gltf(const fs::path& path) {
     for (const SceneNode& node : scene.nodes)
         if (node.skin >= 0)
             for (uint32_t m : node.meshes) check_influences(scene.meshes[m], scene.skins[size_t(node.skin)].joints.size(), file);
+    scene.validate();  // node transforms can carry finite geometry beyond the supported range
     return scene;
 }
 

@@ -48,6 +48,10 @@ MeshCleanupReport validate_and_clean(Mesh& mesh, size_t material_count, const st
         if (!is_finite(mesh.positions[i]))
             throw Error(source, label + ": vertex " + std::to_string(i) + " has a non-finite position " +
                                     format_vec(mesh.positions[i]));
+    for (size_t i = 0; i < nv; ++i)
+        if (max_component(glm::abs(mesh.positions[i])) > kMaxCoordinate)
+            throw Error(source, label + ": vertex " + std::to_string(i) + " at " + format_vec(mesh.positions[i]) +
+                                    " lies beyond the supported coordinate range of ±1e18");
     if (!mesh.normals.empty()) {
         if (mesh.normals.size() != nv)
             throw Error(source, label + ": " + std::to_string(mesh.normals.size()) + " normals for " +

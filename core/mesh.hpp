@@ -21,12 +21,18 @@ struct Mesh {
     Bounds3 bounds() const;
 };
 
+// Largest coordinate magnitude geometry may reach, in a mesh's own space and in the
+// world: Embree's range for vertex positions. Far below float overflow, so extents,
+// edge cross products and ray offsets stay finite.
+inline constexpr float kMaxCoordinate = 1e18f;
+
 struct MeshCleanupReport {
     size_t degenerate_triangles_dropped = 0;
 };
 
-// Checks a freshly loaded mesh: NaN/Inf positions and out-of-range indices are errors
-// (thrown, naming `source`); zero-area triangles are dropped and counted.
+// Checks a freshly loaded mesh: NaN/Inf positions, coordinates beyond kMaxCoordinate and
+// out-of-range indices are errors (thrown, naming `source`); zero-area triangles are
+// dropped and counted.
 MeshCleanupReport validate_and_clean(Mesh& mesh, size_t material_count, const std::string& source);
 
 }  // namespace gilab

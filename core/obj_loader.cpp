@@ -1,94 +1,22 @@
 // Wavefront OBJ + MTL through tinyobjloader. tinyobjloader reads unparsable numbers as
-// 0 and skips faces with bad indices with only a warning, so a quick pre-scan of the
-// file checks vertex and face lines first and reports problems with their line number.
+// 0 and skips faces with bad indices with only a warning, so the OBJ and MTL text is
+// checked first (core/obj_check.hpp) and problems are reported with their line number.
+// Polygons are triangulated in their best-fit plane (core/polygon_triangulation.hpp).
 #include <tiny_obj_loader.h>
 
-#include <charconv>
-#include <fstream>
 #include <regex>
-#include <sstream>
 #include <unordered_map>
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 #include "core/mesh_loaders.hpp"
+#include "core/obj_check.hpp"
+#include "core/polygon_triangulation.hpp"
 
 namespace gilab {
 
 namespace fs = std::filesystem;
 
 namespace {
-
-struct PreScan {
-    std::vector<uint32_t> face_lines;  // line number of every face, in file order
-};
-
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r'; }
-
-std::string_view next_token(std::string_view& rest) {
-    size_t b = 0;
-    while (b < rest.size() && is_space(rest[b])) ++b;
-    size_t e = b;
-    while (e < rest.size() && !is_space(rest[e]) && rest[e] != '#') ++e;
-    std::string_view tok = rest.substr(b, e - b);
-    rest = (e < rest.size() && rest[e] == '#') ? std::string_view{} : rest.substr(e);
-    return tok;
-}
-
-bool parse_float(std::string_view tok, float& out) {
-    if (!tok.empty() && tok.front() == '+') tok.remove_prefix(1);
-    auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), out);
-    return ec == std::errc() && ptr == tok.data() + tok.size();
-}
-
-PreScan prescan(const fs::path& path, const std::string& text) {
-    PreScan scan;
-    const std::string file = path.string();
-    uint32_t line_no = 0;
-    size_t pos = 0;
-    while (pos < text.size()) {
-        size_t end = text.find('\n', pos);
-        if (end == std::string::npos) end = text.size();
-        std::string_view line(text.data() + pos, end - pos);
-        pos = end + 1;
-        ++line_no;
-        size_t b = 0;
-        while (b < line.size() && is_space(line[b])) ++b;
-        line.remove_prefix(b);
-        if (line.size() < 2 || !is_space(line[1])) continue;
-        const std::string where = file + ":" + std::to_string(line_no);
-        if (line[0] == 'v') {
-            std::string_view rest = line.substr(2);
-            for (int k = 0; k < 3; ++k) {
-                std::string_view tok = next_token(rest);
-                float value = 0;
-                if (tok.empty())
-                    throw Error(where, "vertex has " + std::to_string(k) +
-                                           " coordinates, expected 3 (malformed or truncated file)");
-                if (!parse_float(tok, value))
-                    throw Error(where, "vertex coordinate '" + std::string(tok) + "' is not a number");
-                if (!std::isfinite(value))
-                    throw Error(where, "vertex coordinate '" + std::string(tok) + "' is not finite (NaN/Inf vertex)");
-            }
-        } else if (line[0] == 'f') {
-            std::string_view rest = line.substr(2);
-            int corners = 0;
-            while (!next_token(rest).empty()) ++corners;
-            if (corners < 3)
-                throw Error(where, "face has " + std::to_string(corners) +
-                                       " vertices, expected at least 3 (malformed or truncated file)");
-            if (corners > 255) throw Error(where, "face has more than 255 vertices (unsupported)");
-            scan.face_lines.push_back(line_no);
-        }
-    }
-    return scan;
-}
-
-std::string read_text(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(path.string(), "cannot open file");
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
 
 // tinyobjloader's messages end in "(line N.)"; move the line number to the front.
 std::string locate_message(const std::string& file, const std::string& message) {
@@ -102,7 +30,11 @@ std::string locate_message(const std::string& file, const std::string& message) 
 
 Vec3 to_vec3(const tinyobj::real_t v[3]) { return Vec3(float(v[0]), float(v[1]), float(v[2])); }
 
-Material convert_material(const tinyobj::material_t& m, bool& rescaled) {
+Material convert_material(const tinyobj::material_t& m, bool& rescaled, const std::string& file) {
+    for (const tinyobj::real_t* v : {m.diffuse, m.specular, m.emission})
+        if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
+            throw Error(file, "material '" + m.name + "' has a non-finite colour");
+    if (!std::isfinite(m.shininess)) throw Error(file, "material '" + m.name + "' has a non-finite Ns");
     Material out;
     out.name = m.name;
     out.albedo = glm::clamp(to_vec3(m.diffuse), Vec3(0.0f), Vec3(1.0f));
@@ -137,13 +69,17 @@ struct CornerHash {
 
 Scene load_obj(const fs::path& path) {
     const std::string file = path.string();
-    std::error_code ec;
-    if (!fs::is_regular_file(path, ec)) throw Error(file, "file not found");
-
-    const PreScan scan = prescan(path, read_text(path));
+    const ObjScan scan = scan_obj(path, read_input_file(path));
+    for (const fs::path& mtl : scan.material_libraries) {
+        try {
+            check_mtl(mtl);
+        } catch (const Error& e) {
+            throw Error(file, std::string("material library: ") + e.what());
+        }
+    }
 
     tinyobj::ObjReaderConfig config;
-    config.triangulate = false;  // fan-triangulated below, after the indices are checked
+    config.triangulate = false;  // triangulated below, after the indices are checked
     config.vertex_color = false;
     tinyobj::ObjReader reader;
     if (!reader.ParseFromFile(file, config))
@@ -165,7 +101,7 @@ Scene load_obj(const fs::path& path) {
 
     bool rescaled = false, textured = false;
     for (const auto& m : materials) {
-        scene.materials.push_back(convert_material(m, rescaled));
+        scene.materials.push_back(convert_material(m, rescaled, file));
         textured |= !m.diffuse_texname.empty() || !m.specular_texname.empty();
     }
     if (rescaled) scene.warnings.push_back(file + ": Kd + Ks > 1 in some materials; Ks scaled down to conserve energy");
@@ -244,22 +180,37 @@ Scene load_obj(const fs::path& path) {
         return it->second;
     };
 
+    size_t non_planar = 0, fanned = 0;
+    std::vector<Vec3> corner_positions;
+    std::vector<uint32_t> corner_vertices;
     for (const auto& shape : shapes) {
         size_t offset = 0;
         for (size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f) {
             const size_t corners = shape.mesh.num_face_vertices[f];
             const uint32_t mat = material_of(f < shape.mesh.material_ids.size() ? shape.mesh.material_ids[f] : -1);
-            const uint32_t first = vertex_of(shape.mesh.indices[offset]);
-            uint32_t prev = vertex_of(shape.mesh.indices[offset + 1]);
-            for (size_t k = 2; k < corners; ++k) {  // fan: (0, k-1, k)
-                const uint32_t cur = vertex_of(shape.mesh.indices[offset + k]);
-                mesh.triangles.emplace_back(first, prev, cur);
+            corner_positions.clear();
+            corner_vertices.clear();
+            for (size_t k = 0; k < corners; ++k) {
+                const tinyobj::index_t& idx = shape.mesh.indices[offset + k];
+                corner_positions.push_back(to_vec3(&attrib.vertices[3 * size_t(idx.vertex_index)]));
+                corner_vertices.push_back(vertex_of(idx));
+            }
+            const PolygonTriangulation t = triangulate_polygon(corner_positions);
+            non_planar += t.non_planarity > kNonPlanarTolerance;
+            fanned += t.fallback;
+            for (const auto& tri : t.triangles) {
+                mesh.triangles.emplace_back(corner_vertices[tri[0]], corner_vertices[tri[1]], corner_vertices[tri[2]]);
                 mesh.material_ids.push_back(mat);
-                prev = cur;
             }
             offset += corners;
         }
     }
+    if (non_planar)
+        scene.warnings.push_back(file + ": " + std::to_string(non_planar) +
+                                 " faces are not planar; triangulated in their best-fit planes");
+    if (fanned)
+        scene.warnings.push_back(file + ": " + std::to_string(fanned) +
+                                 " faces intersect themselves; fanned from their first corner");
     // Zero-length normals (seen in exported files) are dropped with the whole set.
     for (const Vec3& n : mesh.normals)
         if (!(glm::dot(n, n) > 0.0f)) {

@@ -1,6 +1,8 @@
 #include "core/scene.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include "core/error.hpp"
 #include "core/skin.hpp"
@@ -37,7 +39,9 @@ double Scene::animation_duration() const {
 
 int Scene::animation_frame_count() const {
     if (!is_animated()) return 1;
-    return int(std::floor(animation_duration() * frames_per_second + 1e-6)) + 1;
+    const double frames = std::floor(animation_duration() * frames_per_second + 1e-6) + 1;
+    if (!(frames >= 1)) return 1;
+    return frames >= double(INT32_MAX) ? INT32_MAX : int(frames);  // never wraps negative
 }
 
 size_t Scene::triangle_count() const {
@@ -124,7 +128,16 @@ SceneFrame flatten(const Scene& scene, const std::vector<Mat4>& world, double ti
             wm.node = uint32_t(i);
             if (skinned && !mesh.influences.empty()) place_skinned(mesh, joints[size_t(node.skin)], wm);
             else place_rigid(mesh, world[i], wm);
-            for (const Vec3& q : wm.positions) frame.bounds.extend(q);
+            bool finite = true;
+            for (const Vec3& q : wm.positions) {
+                frame.bounds.extend(q);
+                finite &= is_finite(q);
+            }
+            if (!finite)
+                throw Error(scene.source.empty() ? scene.name : scene.source,
+                            "node " + std::to_string(i) + " ('" + node.name + "') puts mesh '" + mesh.name +
+                                "' at non-finite world positions at t = " + std::to_string(time) +
+                                " s (its transform overflows)");
             wm.material_ids = mesh.material_ids;
             frame.meshes.push_back(std::move(wm));
         }
@@ -169,9 +182,54 @@ std::vector<bool> Scene::dynamic_nodes() const {
     return dynamic;
 }
 
+namespace {
+
+// Bounds on what a node's transform can do over all time, in the ∞-norm: a point p of
+// its meshes lands within offset + linear·|p| of the origin on every axis.
+struct Reach {
+    double linear = 1;
+    double offset = 0;
+};
+
+double max_abs(const Vec3& v) { return std::max({std::abs(double(v.x)), std::abs(double(v.y)), std::abs(double(v.z))}); }
+
+// Local reach of a TRS node over its rest pose and every key (a rotation's ∞-norm is at
+// most √3; interpolated values never exceed the keys').
+Reach local_reach(const SceneNode& n) {
+    double scale = max_abs(n.local.scale), shift = max_abs(n.local.translation);
+    for (const Vec3& s : n.animation.scale.values) scale = std::max(scale, max_abs(s));
+    for (const Vec3& t : n.animation.translation.values) shift = std::max(shift, max_abs(t));
+    return {std::sqrt(3.0) * scale, shift};
+}
+
+Reach matrix_reach(const Mat4& m) {
+    double linear = 0;
+    for (int r = 0; r < 3; ++r)
+        linear = std::max(linear, std::abs(double(m[0][r])) + std::abs(double(m[1][r])) + std::abs(double(m[2][r])));
+    return {linear, max_abs(Vec3(m[3]))};
+}
+
+std::string approx(double x) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.3g", x);
+    return buffer;
+}
+
+}  // namespace
+
 void Scene::validate() const {
     const std::string where = source.empty() ? name : source;
     if (meshes.empty() || triangle_count() == 0) throw Error(where, "scene has no triangles (empty scene)");
+    if (!(std::isfinite(frames_per_second) && frames_per_second > 0))
+        throw Error(where, "frames per second " + approx(frames_per_second) + " must be a positive number");
+    if (is_animated()) {
+        const double frames = std::floor(animation_duration() * frames_per_second + 1e-6) + 1;
+        if (!(frames <= kMaxAnimationFrames))
+            throw Error(where, "the animation lasts " + approx(animation_duration()) + " s, which at " +
+                                   approx(frames_per_second) + " frames per second is " + approx(frames) +
+                                   " frames, more than the " + std::to_string(kMaxAnimationFrames) +
+                                   " supported (check the key times and the frame rate)");
+    }
     for (size_t i = 0; i < nodes.size(); ++i) {
         const SceneNode& n = nodes[i];
         if (n.parent >= int(i)) throw Error(where, "node " + std::to_string(i) + " ('" + n.name + "') has parent " +
@@ -216,6 +274,51 @@ void Scene::validate() const {
     for (const auto& l : lights)
         if (!is_finite(l.position) || !is_finite(l.direction) || !is_finite(l.intensity))
             throw Error(where, "light '" + l.name + "' has a non-finite position, direction or intensity");
+    check_world_reach(where);
+}
+
+// A finite mesh under finite transforms can still overflow (scale 1e30 on a 1e10 model,
+// matrix entries of 1e38): bound every node's reach before anything is rendered.
+void Scene::check_world_reach(const std::string& where) const {
+    std::vector<Reach> world(nodes.size());
+    for (size_t i = 0; i < nodes.size(); ++i) {
+        const SceneNode& n = nodes[i];
+        auto finite_keys = [](const auto& channel) {
+            for (const auto& v : channel.values)
+                for (int c = 0; c < v.length(); ++c)
+                    if (!std::isfinite(v[c])) return false;
+            return true;
+        };
+        const Transform& t = n.local;
+        if (!is_finite(t.translation) || !is_finite(t.scale) || !std::isfinite(glm::length(t.rotation)) ||
+            !finite_keys(n.animation.translation) || !finite_keys(n.animation.rotation) || !finite_keys(n.animation.scale))
+            throw Error(where, "node " + std::to_string(i) + " ('" + n.name + "') has a non-finite transform");
+        const Reach local = local_reach(n);
+        const Reach parent = n.parent >= 0 ? world[size_t(n.parent)] : Reach{};
+        world[i] = {parent.linear * local.linear, parent.offset + parent.linear * local.offset};
+    }
+    std::vector<double> extent(meshes.size());  // largest |coordinate| of each mesh
+    for (size_t m = 0; m < meshes.size(); ++m)
+        for (const Vec3& p : meshes[m].positions) extent[m] = std::max(extent[m], max_abs(p));
+    for (size_t i = 0; i < nodes.size(); ++i) {
+        const SceneNode& n = nodes[i];
+        for (uint32_t m : n.meshes) {
+            double reach = world[i].offset + world[i].linear * extent[m];
+            if (n.skin >= 0 && !meshes[m].influences.empty()) {
+                const Skin& skin = skins[size_t(n.skin)];
+                reach = 0;
+                for (size_t j = 0; j < skin.joints.size(); ++j) {
+                    const Reach& joint = world[skin.joints[j]];
+                    const Reach bind = matrix_reach(skin.inverse_bind[j]);
+                    reach = std::max(reach, joint.offset + joint.linear * (bind.offset + bind.linear * extent[m]));
+                }
+            }
+            if (!(reach <= double(kMaxCoordinate)))
+                throw Error(where, "node " + std::to_string(i) + " ('" + n.name + "') can carry mesh '" + meshes[m].name +
+                                       "' to coordinates of about " + approx(reach) +
+                                       ", beyond the supported range of ±1e18 (check its scale, translation or matrix)");
+        }
+    }
 }
 
 }  // namespace gilab

@@ -54,6 +54,9 @@ struct SceneFrame {
     size_t triangle_count() const;
 };
 
+// More frames than this is a mistyped rate or key time, not an animation to step through.
+inline constexpr int kMaxAnimationFrames = 1000000;
+
 struct Scene {
     std::string name;
     std::string source;              // file it was loaded from, or "builtin:NAME"
@@ -73,7 +76,7 @@ struct Scene {
 
     bool is_animated() const;
     double animation_duration() const;     // seconds; 0 for a static scene
-    int animation_frame_count() const;     // frames at frames_per_second, ≥ 1
+    int animation_frame_count() const;     // frames at frames_per_second, ≥ 1 (validate() bounds it)
     size_t triangle_count() const;         // over all instances
     bool has_emitters() const;             // any emissive triangle or punctual light
 
@@ -97,8 +100,13 @@ struct Scene {
     std::vector<Mat4> rest_node_transforms() const;
 
     // Throws Error naming `source` if the scene cannot be rendered: no geometry,
-    // dangling mesh/material/parent/skin/joint indices, unusable joint influences.
+    // dangling mesh/material/parent/skin/joint indices, unusable joint influences,
+    // non-finite transforms, geometry that any transform (rest or animated) could carry
+    // beyond kMaxCoordinate, or more than kMaxAnimationFrames frames.
     void validate() const;
+
+private:
+    void check_world_reach(const std::string& where) const;
 };
 
 }  // namespace gilab

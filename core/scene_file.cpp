@@ -9,6 +9,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include "core/error.hpp"
+#include "core/input_file.hpp"
+#include "core/json_document.hpp"
 #include "core/mesh_loaders.hpp"
 #include "core/skin.hpp"
 
@@ -19,6 +21,10 @@ using json = nlohmann::json;
 
 namespace {
 
+// Faster than any display or capture rate; a larger value is a typo (1e12 frames per
+// second would overflow the frame count).
+constexpr double kMaxFramesPerSecond = 1000;
+
 std::string escape_key(const std::string& key) {
     std::string out;
     for (char c : key) {
@@ -27,6 +33,12 @@ std::string escape_key(const std::string& key) {
         else out += c;
     }
     return out;
+}
+
+std::string number_text(double x) {
+    std::ostringstream s;
+    s << x;
+    return s.str();
 }
 
 std::string type_name(const json& v) {
@@ -67,6 +79,9 @@ public:
         if (!v.is_number()) fail(ptr, "expected a number, got " + type_name(v));
         const double d = v.get<double>();
         if (!std::isfinite(d)) fail(ptr, "expected a finite number");
+        // Values are stored in single precision: 1e300 would silently become infinity.
+        if (std::abs(d) > double(std::numeric_limits<float>::max()))
+            fail(ptr, number_text(d) + " is out of range (single precision holds at most ±3.4e38)");
         return float(d);
     }
     float positive(const json& v, const std::string& ptr) const {
@@ -155,6 +170,8 @@ struct SceneBuilder {
         std::error_code ec;
         const fs::path local = json_dir / name;
         if (fs::is_regular_file(local, ec)) return local;
+        if (fs::is_directory(local, ec) || fs::is_directory(name, ec))
+            in.fail(ptr, "'" + name + "' is a directory, not a mesh file");
         std::string searched = "the working directory";
         if (!assets.dirs().empty()) searched += ", " + assets.describe();
         searched += ", " + (json_dir.empty() ? std::string(".") : json_dir.string());
@@ -511,8 +528,12 @@ struct SceneBuilder {
         if (!doc.contains("animation")) return;
         const json& v = doc["animation"];
         in.check_object(v, "/animation", {"frames_per_second", "nodes"});
-        if (v.contains("frames_per_second"))
+        if (v.contains("frames_per_second")) {
             scene.frames_per_second = in.positive(v["frames_per_second"], "/animation/frames_per_second");
+            if (scene.frames_per_second > kMaxFramesPerSecond)
+                in.fail("/animation/frames_per_second", number_text(scene.frames_per_second) + " is out of range (0, " +
+                                                            number_text(kMaxFramesPerSecond) + "]");
+        }
         if (!v.contains("nodes")) return;
         const json& nodes = v["nodes"];
         if (!nodes.is_object()) in.fail("/animation/nodes", "expected an object keyed by mesh index or name");
@@ -570,31 +591,9 @@ struct SceneBuilder {
 
 Scene load_scene_file(const fs::path& path, const AssetPaths& assets) {
     const std::string file = path.string();
-    std::ifstream stream(path, std::ios::binary);
-    std::error_code ec;
-    if (!stream || !fs::is_regular_file(path, ec)) throw Error(file, "file not found");
-    std::ostringstream buffer;
-    buffer << stream.rdbuf();
-    const std::string text = buffer.str();
-
-    json doc;
-    try {
-        doc = json::parse(text);
-    } catch (const json::parse_error& e) {
-        size_t line = 1, column = 1;
-        for (size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
-            if (text[i] == '\n') {
-                ++line;
-                column = 1;
-            } else {
-                ++column;
-            }
-        }
-        std::string message = e.what();
-        const size_t colon = message.find(": ");
-        if (colon != std::string::npos && message.rfind("[json.exception", 0) == 0) message = message.substr(colon + 2);
-        throw Error(file + ":" + std::to_string(line) + ":" + std::to_string(column), "JSON syntax error: " + message);
-    }
+    const std::string text = read_input_file(path);
+    check_text_encoding(text, file, "scene JSON");
+    const json doc = parse_json_document(text, file);
 
     Reader in(file);
     in.check_object(doc, "", {"name", "description", "materials", "meshes", "lights", "camera", "hmd", "animation"});

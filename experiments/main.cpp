@@ -3,6 +3,7 @@
 #include <iostream>
 #include "core/error.hpp"
 #include "core/hmd.hpp"
+#include "core/memory_budget.hpp"
 #include "core/parallel.hpp"
 #include "experiments/experiment.hpp"
 #include "experiments/html_report.hpp"
@@ -72,6 +73,35 @@ int run_experiments(const std::vector<std::string>& names, bool quick, const std
     return failures ? 1 : 0;
 }
 
+// --assets directories must exist (a typo would silently fall back to other copies of
+// the same files); missing $GILAB_ASSETS directories only get a note, since the
+// environment is often shared between machines.
+void check_asset_directories(const std::string& flag) {
+    auto each = [](const std::string& list, auto&& f) {
+        size_t start = 0;
+        while (start <= list.size()) {
+            size_t end = list.find(':', start);
+            if (end == std::string::npos) end = list.size();
+            if (end > start) f(list.substr(start, end - start));
+            start = end + 1;
+        }
+    };
+    each(flag, [](const std::string& dir) {
+        std::error_code ec;
+        if (!std::filesystem::is_directory(dir, ec))
+            throw Error("--assets", "'" + dir + "' is not a directory" +
+                                        (std::filesystem::exists(dir, ec) ? "" : " (it does not exist)"));
+    });
+    if (const char* env = std::getenv("GILAB_ASSETS"))
+        each(env, [](const std::string& dir) {
+            std::error_code ec;
+            if (!std::filesystem::is_directory(dir, ec))
+                std::cerr << "gilab: note: $GILAB_ASSETS: '" << dir << "' is not a directory; ignored\n";
+        });
+}
+
+constexpr int kMaxThreads = 1024;
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -79,10 +109,29 @@ int main(int argc, char** argv) {
                  "cascaded voxel cone tracing, reference path tracer)"};
     app.require_subcommand(1);
     int threads = 0;
-    std::string assets_flag;
-    app.add_option("--threads", threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+    std::string assets_flag, memory_limit;
+    app.add_option("--threads", threads, "worker threads (0 = all cores)")
+        ->check(CLI::Validator(
+            [](std::string& text) -> std::string {
+                int n = -1;
+                try {
+                    size_t used = 0;
+                    n = std::stoi(text, &used);
+                    if (used != text.size()) n = -1;
+                } catch (const std::exception&) {
+                }
+                if (n < 0 || n > kMaxThreads)
+                    return "'" + text + "' is not a thread count (0 = all cores, or 1 to " + std::to_string(kMaxThreads) + ")";
+                return "";
+            },
+            "0-" + std::to_string(kMaxThreads), "thread count"));
     app.add_option("--assets", assets_flag,
-                   "asset search path, colon-separated (also $GILAB_ASSETS; default ../shared/scenes beside the source)");
+                   "asset search path, colon-separated; every directory must exist (also $GILAB_ASSETS, whose missing "
+                   "directories are noted and skipped; default ../shared/scenes beside the source)");
+    app.add_option("--memory-limit", memory_limit,
+                   "memory budget for everything sized by input (vertex, face and list counts, glTF buffers, images, "
+                   "frames, film size): bytes or a size such as 8G or 512M; default half the physical memory (" +
+                       MemoryBudget::format(MemoryBudget::default_limit()) + " here)");
 
     RenderRequest request;
     uint64_t seed = 1;
@@ -96,7 +145,9 @@ int main(int argc, char** argv) {
     render->add_option("--spp", request.spp, "samples per pixel");
     render->add_option("--seed", seed, "random seed")->capture_default_str();
     render->add_option("--time", request.time, "scene time in seconds (animated scenes)");
-    render->add_option("-o,--output", request.output, "output path without extension (writes .exr and .png)");
+    render->add_option("-o,--output", request.output,
+                       "output path without extension (writes .exr and .png); its directory must exist, -o never "
+                       "creates directories (the default results/render/ is created)");
     render->add_option("--settings", request.settings_file, "technique settings as a JSON object file");
     render->add_option("--set", request.assignments, "technique setting key=value (repeatable)");
     render->add_option("--exposure", request.exposure, "PNG preview exposure in stops");
@@ -133,6 +184,8 @@ int main(int argc, char** argv) {
     CLI11_PARSE(app, argc, argv);
 
     try {
+        if (!memory_limit.empty()) MemoryBudget::set_limit(MemoryBudget::parse_size(memory_limit, "--memory-limit"));
+        check_asset_directories(assets_flag);
         ThreadLimit limit(threads);
         AssetPaths assets = AssetPaths::from_environment(assets_flag.empty() ? std::nullopt : std::optional(assets_flag));
         if (*render) {
@@ -156,6 +209,10 @@ int main(int argc, char** argv) {
         }
     } catch (const Error& e) {
         std::cerr << "gilab: error: " << e.what() << std::endl;
+        return 1;
+    } catch (const std::bad_alloc&) {
+        std::cerr << "gilab: error: out of memory (the memory limit is " << MemoryBudget::format(MemoryBudget::limit())
+                  << "; see --memory-limit)" << std::endl;
         return 1;
     } catch (const std::exception& e) {
         std::cerr << "gilab: internal error: " << e.what() << std::endl;

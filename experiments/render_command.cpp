@@ -11,6 +11,9 @@
 #include "core/film.hpp"
 #include "core/hmd.hpp"
 #include "core/image_io.hpp"
+#include "core/input_file.hpp"
+#include "core/json_document.hpp"
+#include "core/memory_budget.hpp"
 #include "core/mesh_topology.hpp"
 #include "experiments/result_writers.hpp"
 #include "scenes/scene_library.hpp"
@@ -27,14 +30,11 @@ Settings read_settings(const RenderRequest& request) {
     nlohmann::json values = nlohmann::json::object();
     std::string context = "--set";
     if (request.settings_file) {
-        std::ifstream in(*request.settings_file);
-        if (!in) throw Error(*request.settings_file, "settings file not found or unreadable");
-        try {
-            values = nlohmann::json::parse(in);
-        } catch (const nlohmann::json::parse_error& e) {
-            throw Error(*request.settings_file, std::string("malformed JSON: ") + e.what());
-        }
-        context = *request.settings_file;
+        const std::string& file = *request.settings_file;
+        const std::string text = read_input_file(file);
+        check_text_encoding(text, file, "settings JSON");
+        values = parse_json_document(text, file);
+        context = file;
     }
     Settings settings(values, context);
     for (const auto& a : request.assignments) settings.set_from_string(a);
@@ -101,6 +101,98 @@ std::string default_output(const Scene& scene, const Technique& technique, bool 
     return "results/render/" + scene.name + "_" + technique.name() + (stereo ? "_stereo" : "");
 }
 
+std::string number_text(double value) {
+    std::ostringstream out;
+    out << value;
+    return out.str();
+}
+
+// Every option is checked before the scene loads, so a bad value never costs a render
+// and never leaves a file behind.
+void check_options(const RenderRequest& request) {
+    if (!std::isfinite(request.time)) throw Error("--time", number_text(request.time) + " is not a finite number of seconds");
+    if (request.ipd && !(*request.ipd >= 0 && *request.ipd < 1))
+        throw Error("--ipd", number_text(*request.ipd) + " is out of range: give metres in [0, 1), e.g. 0.063");
+    if (!std::isfinite(request.exposure)) throw Error("--exposure", number_text(request.exposure) + " is not a finite number of stops");
+    if (request.output.empty()) return;
+    // An explicit -o never creates directories: a mistyped directory would otherwise
+    // scatter results where nobody looks.
+    const fs::path out(request.output);
+    if (!out.has_filename() || request.output.back() == '/')
+        throw Error("-o " + request.output, "names a directory; give a file path without extension, e.g. DIR/image");
+    const fs::path dir = out.parent_path();
+    std::error_code ec;
+    if (!dir.empty() && !fs::is_directory(dir, ec))
+        throw Error("-o " + request.output, "directory '" + dir.string() +
+                                                "' does not exist (create it first; -o does not create directories)");
+}
+
+// The default output directory (results/render) is created when missing, with a note.
+void make_default_directory(const fs::path& base) {
+    const fs::path dir = base.parent_path();
+    std::error_code ec;
+    if (dir.empty() || fs::is_directory(dir, ec)) return;
+    fs::create_directories(dir, ec);
+    if (ec) throw Error(dir.string(), "cannot create the output directory: " + ec.message());
+    std::cerr << "gilab: note: created directory " << dir.string() << "\n";
+}
+
+// Outputs go to hidden temporary names and are renamed into place only when every one
+// has been written, so a failed run leaves nothing half-written behind.
+class StagedOutputs {
+public:
+    StagedOutputs() = default;
+    StagedOutputs(const StagedOutputs&) = delete;
+    StagedOutputs& operator=(const StagedOutputs&) = delete;
+    ~StagedOutputs() {
+        for (const auto& [temp, target] : files_) {
+            std::error_code ec;
+            fs::remove(temp, ec);
+        }
+    }
+    // Where to write `target` for now.
+    fs::path stage(const fs::path& target) {
+        // Appended piecewise: GCC 12 warns falsely (-Wrestrict) on "." + std::string.
+        std::string name(1, '.');
+        name += target.filename().string();
+        name += ".partial";
+        const fs::path temp = target.parent_path() / name;
+        files_.emplace_back(temp, target);
+        return temp;
+    }
+    void commit() {
+        for (size_t i = 0; i < files_.size(); ++i) {
+            std::error_code ec;
+            fs::rename(files_[i].first, files_[i].second, ec);
+            if (ec) throw Error(files_[i].second.string(), "cannot move the finished file into place: " + ec.message());
+        }
+        files_.clear();
+    }
+
+private:
+    std::vector<std::pair<fs::path, fs::path>> files_;  // temporary, target
+};
+
+// A default camera that looks past the geometry (or at its edge) gives a black image;
+// say so instead of leaving a silent black file.
+void warn_if_unseen(const OpenedScene& opened, const std::vector<Film>& films) {
+    if (!opened.default_camera) return;
+    for (const Film& film : films)
+        for (float v : film.layer("color").data)
+            if (v != 0.0f) return;
+    std::cerr << "gilab: warning: " << opened.scene.name
+              << ": the default camera sees nothing (the image is black); give the scene a camera\n";
+}
+
+// The films a render allocates (a handful of 3-channel float layers per view) come out of
+// the memory budget like everything else sized by input.
+void check_film_memory(int width, int height, int views) {
+    constexpr uint64_t kLayerBytesPerPixel = 8 * 3 * sizeof(float);
+    MemoryBudget::check(MemoryBudget::times(uint64_t(width) * uint64_t(height) * uint64_t(views), kLayerBytesPerPixel),
+                        "a " + std::to_string(width) + "×" + std::to_string(height) + " film" + (views > 1 ? " per eye" : ""),
+                        "--width/--height");
+}
+
 std::string format_number(double value, int precision) {
     std::ostringstream out;
     out << std::fixed << std::setprecision(precision) << value;
@@ -109,10 +201,12 @@ std::string format_number(double value, int precision) {
 
 // Frame k at t = k / fps: the head follows the trace from the rig's starting pose.
 std::vector<std::string> render_sequence(const TracePlan& plan, Technique& technique, HmdRig& rig,
-                                         const Scene& scene, const Settings& settings, const RenderRequest& request) {
+                                         const OpenedScene& opened, const Settings& settings, const RenderRequest& request) {
+    const Scene& scene = opened.scene;
     std::string base = request.output.empty() ? default_output(scene, technique, true) : request.output;
     fs::path csv_path = base + "_frames.csv";
-    if (csv_path.has_parent_path()) fs::create_directories(csv_path.parent_path());
+    if (request.output.empty()) make_default_directory(csv_path);
+    StagedOutputs staged;
 
     const HeadPose start = rig.pose();
     std::ostringstream csv;
@@ -144,15 +238,17 @@ std::vector<std::string> render_sequence(const TracePlan& plan, Technique& techn
         char suffix[32];
         std::snprintf(suffix, sizeof suffix, "_%04d", k);
         fs::path exr = base + suffix + ".exr", png = base + suffix + ".png";
-        write_exr_stereo(exr, frame.left, frame.right);
-        write_png_side_by_side(png, frame.left, frame.right, request.exposure);
+        if (k == 0) warn_if_unseen(opened, {frame.left, frame.right});
+        write_exr_stereo(staged.stage(exr), frame.left, frame.right);
+        write_png_side_by_side(staged.stage(png), frame.left, frame.right, request.exposure);
         written.push_back(exr.string());
         written.push_back(png.string());
         csv << k << "," << format_number(t, 6) << "," << pose_text << "," << format_number(frame.render_ms, 3) << "\n";
         std::cout << "frame " << (k + 1) << "/" << plan.frames << "  t = " << format_number(t, 4) << " s  render "
                   << format_number(frame.render_ms, 1) << " ms  " << exr.string() << std::endl;
     }
-    write_file_atomically(csv_path, csv.str());
+    write_file_atomically(staged.stage(csv_path), csv.str());
+    staged.commit();
     written.push_back(csv_path.string());
     std::cout << "rendered " << scene.name << " with " << technique.name() << " (2 eyes, " << rig.preset().width
               << "×" << rig.preset().height << "), " << plan.frames << " frames along " << plan.path << " in "
@@ -163,6 +259,7 @@ std::vector<std::string> render_sequence(const TracePlan& plan, Technique& techn
 }  // namespace
 
 std::vector<std::string> run_render(const RenderRequest& request) {
+    check_options(request);
     const TechniqueRegistry& registry = TechniqueRegistry::builtin();
     std::unique_ptr<Technique> technique = registry.create(request.technique);  // fail fast on a bad name
     Settings settings = read_settings(request);
@@ -185,17 +282,19 @@ std::vector<std::string> run_render(const RenderRequest& request) {
         if (request.ipd) rig->set_ipd(*request.ipd);
         if (request.width) rig->set_resolution(*request.width, *request.height);
         check_resolution(rig->preset().width, rig->preset().height);
+        check_film_memory(rig->preset().width, rig->preset().height, 2);
         views = ViewSet::stereo_pair(rig->eye(Eye::Left), rig->eye(Eye::Right));
     } else {
         int w = request.width.value_or(512), h = request.height.value_or(512);
         check_resolution(w, h);
+        check_film_memory(w, h, 1);
         const SceneCamera& c = *scene.camera;
         views = ViewSet::mono(EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, w, h));
     }
 
     technique->prepare(scene, settings);
     settings.report_unused();
-    if (plan) return render_sequence(*plan, *technique, *rig, scene, settings, request);
+    if (plan) return render_sequence(*plan, *technique, *rig, opened, settings, request);
 
     if (request.time != 0) technique->update(request.time);
     std::vector<Film> films(views.views.size());
@@ -204,17 +303,20 @@ std::vector<std::string> run_render(const RenderRequest& request) {
     for (size_t i = 0; i < films.size(); ++i)
         tag_film(films[i], scene, views.names[i], *technique, settings, request, rig ? &*rig : nullptr);
 
+    warn_if_unseen(opened, films);
     std::string base = request.output;
     if (base.empty()) base = default_output(scene, *technique, rig.has_value());
     fs::path exr = base + ".exr", png = base + ".png";
-    if (exr.has_parent_path()) fs::create_directories(exr.parent_path());
+    if (request.output.empty()) make_default_directory(exr);
+    StagedOutputs staged;
     if (films.size() == 2) {
-        write_exr_stereo(exr, films[0], films[1]);
-        write_png_side_by_side(png, films[0], films[1], request.exposure);
+        write_exr_stereo(staged.stage(exr), films[0], films[1]);
+        write_png_side_by_side(staged.stage(png), films[0], films[1], request.exposure);
     } else {
-        write_exr(exr, films[0]);
-        write_png(png, films[0], request.exposure);
+        write_exr(staged.stage(exr), films[0]);
+        write_png(staged.stage(png), films[0], request.exposure);
     }
+    staged.commit();
     Stats stats = technique->stats();
     std::cout << "rendered " << scene.name << " with " << technique->name() << " (" << views.views.size()
               << (views.views.size() == 2 ? " eyes" : " view") << ", " << films[0].width() << "×" << films[0].height()

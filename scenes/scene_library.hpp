@@ -13,6 +13,7 @@ namespace gilab {
 struct OpenedScene {
     Scene scene;
     std::vector<std::string> warnings;
+    bool default_camera = false;  // the scene had no camera; default_camera_for chose one
 };
 
 OpenedScene open_scene(const std::string& spec, const AssetPaths& assets);
@@ -21,7 +22,13 @@ std::vector<std::string> scene_file_names();
 // The directory holding the shipped scene files.
 std::string scenes_directory();
 
-// A camera looking at the scene bounds from the front (−Z side), used when none is given.
+// A camera framing the bounds, used when a scene gives none: from the front (−Z side),
+// a little above; for flat bounds (one extent under 1% of the largest) straight along
+// the thin axis, so a flat model is seen face-on rather than edge-on.
 SceneCamera default_camera_for(const Bounds3& bounds);
+// The same, but when that view would see the surface nearly edge-on (under 5% of its
+// area face-on, e.g. a tilted flat model), looks along the direction most of the
+// surface faces instead. `edge_on` tells whether even that view sees it edge-on.
+SceneCamera default_camera_for(const SceneFrame& frame, bool* edge_on = nullptr);
 
 }  // namespace gilab

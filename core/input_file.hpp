@@ -1,0 +1,22 @@
+#pragma once
+// Reading a file the user named. It must exist and be a regular file (a directory or a
+// device would read as garbage or as "infinitely" long); its size counts against the
+// memory budget before it is read; text formats refuse UTF-16 and NUL bytes, which
+// parsers otherwise read as an empty or nonsensical file.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+namespace gilab {
+
+// Size in bytes; throws Error(path, "file not found" | "is a directory, not a file" | ...).
+uint64_t input_file_size(const std::filesystem::path& path);
+
+// The whole file, after input_file_size's checks and MemoryBudget::check of its size.
+std::string read_input_file(const std::filesystem::path& path);
+
+// Throws Error(file, ...) when `bytes` is UTF-16 (byte-order mark or NUL bytes) or holds
+// NUL bytes; `format` names the expected text format, e.g. "OBJ".
+void check_text_encoding(const std::string& bytes, const std::string& file, const std::string& format);
+
+}  // namespace gilab
