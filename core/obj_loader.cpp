@@ -180,7 +180,7 @@ Scene load_obj(const fs::path& path) {
         return it->second;
     };
 
-    size_t non_planar = 0, fanned = 0;
+    TriangulationTally tally;
     std::vector<Vec3> corner_positions;
     std::vector<uint32_t> corner_vertices;
     for (const auto& shape : shapes) {
@@ -196,8 +196,7 @@ Scene load_obj(const fs::path& path) {
                 corner_vertices.push_back(vertex_of(idx));
             }
             const PolygonTriangulation t = triangulate_polygon(corner_positions);
-            non_planar += t.non_planarity > kNonPlanarTolerance;
-            fanned += t.fallback;
+            tally.count(t);
             for (const auto& tri : t.triangles) {
                 mesh.triangles.emplace_back(corner_vertices[tri[0]], corner_vertices[tri[1]], corner_vertices[tri[2]]);
                 mesh.material_ids.push_back(mat);
@@ -205,12 +204,7 @@ Scene load_obj(const fs::path& path) {
             offset += corners;
         }
     }
-    if (non_planar)
-        scene.warnings.push_back(file + ": " + std::to_string(non_planar) +
-                                 " faces are not planar; triangulated in their best-fit planes");
-    if (fanned)
-        scene.warnings.push_back(file + ": " + std::to_string(fanned) +
-                                 " faces intersect themselves; fanned from their first corner");
+    tally.add_notes(file, scene.warnings);
     // Zero-length normals (seen in exported files) are dropped with the whole set.
     for (const Vec3& n : mesh.normals)
         if (!(glm::dot(n, n) > 0.0f)) {

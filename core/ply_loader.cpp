@@ -63,7 +63,7 @@ Scene load_ply_or_off(const fs::path& path) {
     mesh.name = path.stem().string();
     mesh.positions.reserve(points.size());
     for (const Point& p : points) mesh.positions.emplace_back(float(p.x()), float(p.y()), float(p.z()));
-    size_t non_planar = 0, fanned = 0;
+    TriangulationTally tally;
     std::vector<Vec3> corners;
     for (size_t f = 0; f < polygons.size(); ++f) {
         const auto& poly = polygons[f];
@@ -79,8 +79,7 @@ Scene load_ply_or_off(const fs::path& path) {
             corners.push_back(mesh.positions[v]);
         }
         const PolygonTriangulation t = triangulate_polygon(corners);
-        non_planar += t.non_planarity > kNonPlanarTolerance;
-        fanned += t.fallback;
+        tally.count(t);
         for (const auto& tri : t.triangles)
             mesh.triangles.emplace_back(uint32_t(poly[tri[0]]), uint32_t(poly[tri[1]]), uint32_t(poly[tri[2]]));
     }
@@ -91,12 +90,7 @@ Scene load_ply_or_off(const fs::path& path) {
     scene.name = mesh.name;
     scene.source = file;
     scene.materials.push_back(Material{});
-    if (non_planar)
-        scene.warnings.push_back(file + ": " + std::to_string(non_planar) +
-                                 " faces are not planar; triangulated in their best-fit planes");
-    if (fanned)
-        scene.warnings.push_back(file + ": " + std::to_string(fanned) +
-                                 " faces intersect themselves (or are too large to cut into ears); fanned from their first corner");
+    tally.add_notes(file, scene.warnings);
     scene.degenerate_triangles_dropped = validate_and_clean(mesh, 1, file).degenerate_triangles_dropped;
     scene.add_mesh_instance(std::move(mesh));
     return scene;

@@ -129,4 +129,13 @@ PolygonTriangulation triangulate_polygon(std::span<const Vec3> corners) {
     return out;
 }
 
+void TriangulationTally::add_notes(const std::string& file, std::vector<std::string>& notes) const {
+    if (non_planar)
+        notes.push_back(file + ": " + std::to_string(non_planar) +
+                        " faces are not planar; triangulated in their best-fit planes");
+    if (fanned)
+        notes.push_back(file + ": " + std::to_string(fanned) +
+                        " faces intersect themselves (or are too large to cut into ears); fanned from their first corner");
+}
+
 }  // namespace gilab

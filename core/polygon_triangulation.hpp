@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 #include "core/math.hpp"
 
@@ -26,5 +27,17 @@ inline constexpr float kNonPlanarTolerance = 0.01f;
 
 // Triangulates corners c[0..n-1] (n ≥ 3) in order: n - 2 triangles.
 PolygonTriangulation triangulate_polygon(std::span<const Vec3> corners);
+
+// What the triangulations of one file's faces had to report, as a loader's notes.
+struct TriangulationTally {
+    size_t non_planar = 0;  // faces beyond kNonPlanarTolerance
+    size_t fanned = 0;      // faces that fell back to a fan
+    void count(const PolygonTriangulation& t) {
+        non_planar += t.non_planarity > kNonPlanarTolerance;
+        fanned += t.fallback;
+    }
+    // Appends one note per kind of face found, naming `file`.
+    void add_notes(const std::string& file, std::vector<std::string>& notes) const;
+};
 
 }  // namespace gilab

@@ -25,16 +25,6 @@ namespace {
 // second would overflow the frame count).
 constexpr double kMaxFramesPerSecond = 1000;
 
-std::string escape_key(const std::string& key) {
-    std::string out;
-    for (char c : key) {
-        if (c == '~') out += "~0";
-        else if (c == '/') out += "~1";
-        else out += c;
-    }
-    return out;
-}
-
 std::string number_text(double x) {
     std::ostringstream s;
     s << x;
@@ -65,7 +55,7 @@ public:
         if (!v.is_object()) fail(ptr, "expected an object, got " + type_name(v));
         for (auto it = v.begin(); it != v.end(); ++it)
             if (std::find(allowed.begin(), allowed.end(), it.key()) == allowed.end())
-                fail(ptr + "/" + escape_key(it.key()), "unknown key '" + it.key() + "' (expected one of: " + join(allowed) + ")");
+                fail(ptr + "/" + json_pointer_token(it.key()), "unknown key '" + it.key() + "' (expected one of: " + join(allowed) + ")");
     }
 
     void exclusive(const json& v, const std::string& ptr, const std::vector<std::string>& keys) const {
@@ -267,7 +257,7 @@ struct SceneBuilder {
         const json& mats = doc["materials"];
         if (!mats.is_object()) in.fail("/materials", "expected an object mapping names to materials, got " + type_name(mats));
         for (auto it = mats.begin(); it != mats.end(); ++it) {
-            const std::string ptr = "/materials/" + escape_key(it.key());
+            const std::string ptr = "/materials/" + json_pointer_token(it.key());
             const json& v = it.value();
             in.check_object(v, ptr, {"albedo", "specular", "phong_exponent", "roughness", "emission"});
             in.exclusive(v, ptr, {"phong_exponent", "roughness"});
@@ -538,7 +528,7 @@ struct SceneBuilder {
         const json& nodes = v["nodes"];
         if (!nodes.is_object()) in.fail("/animation/nodes", "expected an object keyed by mesh index or name");
         for (auto it = nodes.begin(); it != nodes.end(); ++it) {
-            const std::string ptr = "/animation/nodes/" + escape_key(it.key());
+            const std::string ptr = "/animation/nodes/" + json_pointer_token(it.key());
             const uint32_t node = entry_node_for(it.key(), ptr);
             const json& a = it.value();
             in.check_object(a, ptr, {"translation", "rotation", "rotation_degrees", "scale", "interpolation"});

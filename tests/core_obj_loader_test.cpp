@@ -257,7 +257,9 @@ TEST_P(RealObj, MatchesManifestCounts) {
     ASSERT_EQ(s.meshes.size(), 1u);
     const Mesh& m = s.meshes[0];
     // No normals/uvs in these files, so OBJ vertices map one to one.
-    if (m.normals.empty() && m.uvs.empty()) EXPECT_EQ(m.positions.size(), a.vertices);
+    if (m.normals.empty() && m.uvs.empty()) {
+        EXPECT_EQ(m.positions.size(), a.vertices);
+    }
     EXPECT_EQ(m.triangles.size() + s.degenerate_triangles_dropped, a.triangles)
         << "loaded " << m.triangles.size() << ", dropped " << s.degenerate_triangles_dropped;
     EXPECT_EQ(m.material_ids.size(), m.triangles.size());

@@ -130,7 +130,9 @@ TEST(CornellBox, HasThirtyGeometryTrianglesPlusTheLight) {
     for (size_t i = 0; i < m.triangles.size(); ++i) {
         const UVec3& t = m.triangles[i];
         Vec3 n = glm::cross(m.positions[t.y] - m.positions[t.x], m.positions[t.z] - m.positions[t.x]);
-        if (s.materials[m.material_ids[i]].is_emissive()) EXPECT_LT(n.y, 0.0f);
+        if (s.materials[m.material_ids[i]].is_emissive()) {
+            EXPECT_LT(n.y, 0.0f);
+        }
     }
     (void)inside;
 }

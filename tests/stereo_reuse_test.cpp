@@ -481,7 +481,9 @@ TEST(Foveation, TheFoveaFollowsTheGaze) {
         render_views(scene, ViewSet::mono(eye), with(base, {{"foveated", true}, {"fovea_angle", 8}, {"gaze_yaw", 30}})).at(0);
     for (int y = 0; y < eye.height(); ++y)
         for (int x = 0; x < eye.width(); ++x)
-            if (foveated_block_size(eye, f, x, y) == 1) ASSERT_EQ(gazed.get("color", x, y), full.get("color", x, y));
+            if (foveated_block_size(eye, f, x, y) == 1) {
+                ASSERT_EQ(gazed.get("color", x, y), full.get("color", x, y));
+            }
 }
 
 TEST(Foveation, CombinesWithStereoReuse) {

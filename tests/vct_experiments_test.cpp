@@ -67,7 +67,9 @@ TEST_F(VctExperiments, MemoryChargesEachStructureItsRealEncodingInMegabytesOfTen
         EXPECT_EQ(fixed.rfind("yes", 0) == 0, structure == "3D texture" || structure == "cascaded") << row.dump();
         if (structure == "3D texture") {
             EXPECT_DOUBLE_EQ(memory, n * n * n / 1e6);  // one byte per cell
-            if (n == 128) EXPECT_EQ(row.at("paper memory (MiB, printed as MB)").get<double>(), 2.0);
+            if (n == 128) {
+                EXPECT_EQ(row.at("paper memory (MiB, printed as MB)").get<double>(), 2.0);
+            }
             ++checked;
         } else if (structure == "cascaded") {
             const double levels = std::log2(n / 32.0) + 1;  // 32³ per level, finest voxel = the grid's
@@ -129,10 +131,12 @@ TEST_F(VctExperiments, SibenikStandsBesideSponzaAndTheWalkHasThePhotonCurve) {
     for (const json& row : table2.tables.at(0).rows) {
         if (row.at("scene") != "sibenik") continue;
         ++sibenik_rows;
-        if (row.at("structure") == "3D texture" && resolution_of(row) == 256)
+        if (resolution_of(row) != 256) continue;
+        if (row.at("structure") == "3D texture") {
             EXPECT_EQ(row.at("paper voxels_millions").get<double>(), 16.78);
-        if (row.at("structure") == "SVO" && resolution_of(row) == 256)
+        } else if (row.at("structure") == "SVO") {
             EXPECT_EQ(row.at("paper voxels_millions").get<double>(), 2.916);
+        }
     }
     EXPECT_EQ(sibenik_rows, sibenik ? 12 : 0);  // 6 structures × 2 resolutions
 
@@ -146,7 +150,9 @@ TEST_F(VctExperiments, SibenikStandsBesideSponzaAndTheWalkHasThePhotonCurve) {
     const std::set<std::string> expected = {"dense mip", "cascaded, update everything", "cascaded, update strategy",
                                             "photon mapping"};
     EXPECT_EQ(variants["sponza"], expected);
-    if (sibenik) EXPECT_EQ(variants["sibenik"], expected);
+    if (sibenik) {
+        EXPECT_EQ(variants["sibenik"], expected);
+    }
     EXPECT_EQ(variants.size(), sibenik ? 2u : 1u);
 }
 

@@ -35,11 +35,6 @@ Film render_one(VctTechnique& t, const EyeCamera& camera) {
     return films.at(0);
 }
 
-EyeCamera cornell_camera(const Scene& scene, int size) {
-    const SceneCamera& c = *scene.camera;
-    return EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, size, size);
-}
-
 // A viewer inside the box (the cascades centre on the viewer: seen from the usual
 // camera 1.4 units in front of the box, the box would fall in the coarsest levels).
 EyeCamera inside_camera(int size) {
