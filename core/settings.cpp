@@ -1,5 +1,6 @@
 #include "core/settings.hpp"
 
+#include <cmath>
 #include <sstream>
 #include "core/rng.hpp"
 
@@ -19,6 +20,26 @@ void Settings::set_from_string(const std::string& assignment) {
     std::string text = assignment.substr(eq + 1);
     auto parsed = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
     values_[key] = parsed.is_discarded() ? nlohmann::json(text) : parsed;
+}
+
+void Settings::check_number(const std::string& key, long double lo, long double hi, bool integral) const {
+    const nlohmann::json& v = values_.at(key);
+    if (!v.is_number()) throw Error(context_, "setting '" + key + "' has the wrong type: " + v.dump() + " (expected a number)");
+    long double x = 0;
+    if (v.is_number_unsigned()) x = (long double)v.get<uint64_t>();
+    else if (v.is_number_integer()) x = (long double)v.get<int64_t>();
+    else {
+        const double d = v.get<double>();
+        if (!std::isfinite(d)) throw Error(context_, "setting '" + key + "' is not a finite number: " + v.dump());
+        if (integral && d != std::floor(d))
+            throw Error(context_, "setting '" + key + "' must be a whole number, got " + v.dump());
+        x = (long double)d;
+    }
+    if (x < lo || x > hi) {
+        std::ostringstream range;
+        range << "[" << double(lo) << ", " << double(hi) << "]";
+        throw Error(context_, "setting '" + key + "' = " + v.dump() + " is out of range " + range.str());
+    }
 }
 
 void Settings::report_unused() const {

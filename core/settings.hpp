@@ -1,8 +1,10 @@
 #pragma once
 // A dictionary of settings (from JSON or CLI "key=value" pairs) that remembers which keys
 // were read, so misspelt or unsupported keys are reported instead of silently ignored.
+#include <limits>
 #include <set>
 #include <string>
+#include <type_traits>
 #include <nlohmann/json.hpp>
 #include "core/error.hpp"
 
@@ -44,12 +46,21 @@ public:
 private:
     template <typename T>
     T convert(const std::string& key) const {
+        // A number must be finite and fit the type it is read as (1e19 read as a 64-bit
+        // integer would wrap); integers must be whole. Checked before the conversion.
+        if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>)
+            check_number(key, (long double)std::numeric_limits<T>::lowest(), (long double)std::numeric_limits<T>::max(),
+                         std::is_integral_v<T>);
         try {
             return values_.at(key).get<T>();
         } catch (const nlohmann::json::exception&) {
             throw Error(context_, "setting '" + key + "' has the wrong type: " + values_.at(key).dump());
         }
     }
+    // Throws Error naming the key unless its value is a finite number in [lo, hi] (and
+    // whole when `integral`).
+    void check_number(const std::string& key, long double lo, long double hi, bool integral) const;
+
     nlohmann::json values_;
     std::string context_ = "settings";
     mutable std::set<std::string> read_;

@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <cmath>
 #include "core/settings.hpp"
 
 using namespace gilab;
@@ -35,6 +36,36 @@ TEST(Settings, ParsesAssignmentsAndRejectsWrongTypes) {
     EXPECT_THROW(s.set_from_string("novalue"), Error);
     EXPECT_THROW(s.get<int>("map", 0), Error);
     EXPECT_THROW(s.require<int>("missing"), Error);
+}
+
+// A number must fit the type it is read as: nothing wraps, truncates or turns infinite.
+TEST(Settings, NumbersMustBeFiniteWholeWhereIntegralAndInRange) {
+    Settings s(nlohmann::json{{"big", 1e19},
+                              {"half", 2.5},
+                              {"huge_float", 1e39},
+                              {"three_billion", 3000000000ull},
+                              {"million", 1e6},
+                              {"nan", std::nan("")},
+                              {"negative", -1}},
+               "numbers");
+    auto message = [&](auto read) {
+        try {
+            read();
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string("accepted");
+    };
+    EXPECT_NE(message([&] { s.get<int64_t>("big", 0); }).find("'big' = 1e+19 is out of range"), std::string::npos);
+    EXPECT_NE(message([&] { s.get<int>("half", 0); }).find("'half' must be a whole number"), std::string::npos);
+    EXPECT_NE(message([&] { s.get<float>("huge_float", 0); }).find("'huge_float'"), std::string::npos);
+    EXPECT_NE(message([&] { s.get<int>("three_billion", 0); }).find("out of range"), std::string::npos);
+    EXPECT_NE(message([&] { s.get<uint32_t>("negative", 0); }).find("out of range"), std::string::npos);
+    EXPECT_NE(message([&] { s.get<double>("nan", 0); }).find("'nan' is not a finite number"), std::string::npos);
+    EXPECT_EQ(s.get<int64_t>("million", 0), 1000000);
+    EXPECT_DOUBLE_EQ(s.get<double>("half", 0), 2.5);
+    EXPECT_EQ(s.get<int64_t>("three_billion", 0), 3000000000);
+    EXPECT_EQ(s.get<int>("negative", 0), -1);
 }
 
 TEST(Settings, HashIsStableAndSensitive) {

@@ -511,6 +511,9 @@ TEST(PhotonMapping, BadSettingsAreErrorsNamingTheKey) {
         {{{"k", 0}}, "'k'"},
         {{{"k", 0}, {"gather", "knn"}}, "'k'"},
         {{{"photons", 0}}, "'photons'"},
+        {{{"photons", 1e12}}, "'photons'"},  // beyond any memory budget: refused before tracing
+        {{{"photons", 1e19}}, "'photons'"},  // beyond 64 bits: no longer wraps to a negative count
+        {{{"photons", 2.5}}, "'photons'"},
         {{{"gather", "heap"}}, "'gather'"},
         {{{"photon_map", "octree"}}, "photon_map"},
         {{{"hash_query", "cells9"}}, "hash_query"},

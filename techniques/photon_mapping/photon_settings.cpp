@@ -1,6 +1,7 @@
 #include <cmath>
 #include "core/error.hpp"
 #include "core/format.hpp"
+#include "core/memory_budget.hpp"
 #include "techniques/photon_mapping/photon_technique.hpp"
 
 namespace gilab {
@@ -37,6 +38,14 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
 
     if (photons < 1) throw Error(where, "setting 'photons' must be at least 1, got " + std::to_string(photons));
     p.photons = uint64_t(photons);
+    // The least a map can hold is about one stored copy per emitted photon (a closed
+    // scene stores at least that): its record and its structure-of-arrays copy. A count
+    // that cannot fit is refused before any photon is traced.
+    constexpr uint64_t kBytesPerStoredPhoton = sizeof(Photon) + 10 * sizeof(float);
+    MemoryBudget::check(MemoryBudget::times(p.photons, kBytesPerStoredPhoton),
+                        "setting 'photons' = " + std::to_string(p.photons) + " (about " +
+                            std::to_string(kBytesPerStoredPhoton) + " B per stored photon, one per emitted photon at least)",
+                        where);
     if (!(p.radius > 0.0f) || !std::isfinite(p.radius))
         throw Error(where, "setting 'radius' must be positive and finite, got " + format_number(p.radius));
     if (gather == "radius")
