@@ -145,6 +145,23 @@ HashGridPhotonMap uniform_grid(float radius) {
     return grid;
 }
 
+// The split pass's per-hit gather may walk the hits sorted by cell or by screen tiles (the
+// paper's kernel, what tile_shared=paper is timed against): the same image either way, and
+// neither shares a fetch.
+TEST(PhotonMapping, GatherOrderChangesNothingButTheWalk) {
+    Scene scene = make_cornell_box();
+    EyeCamera camera = cornell_camera(scene, 48);
+    for (const char* storage : {"indirect", "every_hit"}) {
+        const nlohmann::json s = with(kBase, {{"pass", "split"}, {"photon_storage", storage}, {"share_tile", 4}});
+        Stats by_cell, by_tiles;
+        Film cell = render("photon", scene, camera, with(s, {{"gather_order", "cell"}}), &by_cell);
+        Film tiles = render("photon", scene, camera, with(s, {{"gather_order", "tiles"}}), &by_tiles);
+        expect_identical(cell, tiles, storage);
+        EXPECT_EQ(by_cell.get("tile_groups") + by_tiles.get("tile_groups"), 0.0) << storage;
+        EXPECT_EQ(by_cell.get("gather_queries"), by_tiles.get("gather_queries")) << storage;
+    }
+}
+
 TEST(PhotonMapping, PaperTilesShareOnlyWhenEveryHitIsInOneCell) {
     // A hand-made 8×8 tile of gather points inside one hash cell (one pixel without a
     // hit), then the same tile with one point moved into the neighbouring cell.
@@ -518,6 +535,10 @@ TEST(PhotonMapping, BadSettingsAreErrorsNamingTheKey) {
         {{{"photon_map", "octree"}}, "photon_map"},
         {{{"hash_query", "cells9"}}, "hash_query"},
         {{{"pass", "hybrid"}}, "'pass'"},
+        {{{"gather_order", "morton"}, {"pass", "split"}}, "'gather_order'"},
+        {{{"gather_order", "tiles"}}, "'gather_order'"},  // pass=fused has no gather pass to order
+        {{{"gather_order", "cell"}, {"pass", "split"}, {"tile_shared", "paper"}}, "gather_order=tiles"},
+        {{{"gather_order", "tiles"}, {"pass", "split"}, {"tile_shared", "cell_groups"}}, "gather_order=cell"},
         {{{"tile_shared", true}, {"photon_map", "kd_tree"}}, "'tile_shared'"},
         {{{"max_photon_depth", 0}}, "'max_photon_depth'"},
         {{{"light_samples", -1}}, "'light_samples'"},

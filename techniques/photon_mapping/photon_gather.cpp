@@ -30,12 +30,18 @@ __attribute__((target_clones("avx2", "default"))) PhotonEstimate sum_flux_runs(
     // and per-lane counts stay far below 2^24, so float counters are exact too).
     // (size_t indices: with 32-bit ones the compiler cannot prove that lanes are adjacent
     // in memory, since 32-bit arithmetic may wrap, and builds vectors element by element.)
-    auto lane = [&](int l, size_t j) {
+    // in = 1 inside the radius; the returned weight is `in` for a photon arriving from
+    // the surface's side, else 0.
+    auto weight = [&](size_t j, float& in) {
         float dx = qx - px[j], dy = qy - py[j], dz = qz - pz[j];
         float d2 = dx * dx + dy * dy + dz * dz;
         float c = wx[j] * nx + wy[j] * ny + wz[j] * nz;
-        float in = d2 <= r2 ? 1.0f : 0.0f;
-        float w = c > 0.0f ? in : 0.0f;
+        in = d2 <= r2 ? 1.0f : 0.0f;
+        return c > 0.0f ? in : 0.0f;
+    };
+    auto lane = [&](int l, size_t j) {
+        float in;
+        const float w = weight(j, in);
         ar[l] += w * pr[j];
         ag[l] += w * pg[j];
         ab[l] += w * pb[j];
@@ -43,11 +49,8 @@ __attribute__((target_clones("avx2", "default"))) PhotonEstimate sum_flux_runs(
     };
     // The same with the first-hit flag f ∈ {0, 1} splitting w into w·f and w − w·f (exact).
     auto lane_split = [&](int l, size_t j) {
-        float dx = qx - px[j], dy = qy - py[j], dz = qz - pz[j];
-        float d2 = dx * dx + dy * dy + dz * dz;
-        float c = wx[j] * nx + wy[j] * ny + wz[j] * nz;
-        float in = d2 <= r2 ? 1.0f : 0.0f;
-        float w = c > 0.0f ? in : 0.0f;
+        float in;
+        const float w = weight(j, in);
         float wd = w * pf[j], wi = w - wd;
         ar[l] += wi * pr[j];
         ag[l] += wi * pg[j];

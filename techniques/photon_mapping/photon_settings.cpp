@@ -21,6 +21,8 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     std::string storage = s.get<std::string>("photon_storage", to_string(p.storage));
     p.tile_shared = parse_tile_share(s.get<nlohmann::json>("tile_shared", to_string(p.tile_shared)), where);
     p.share_tile = s.get<int>("share_tile", p.share_tile);
+    const bool order_given = s.has("gather_order");
+    std::string order = s.get<std::string>("gather_order", p.tile_shared == TileShare::Paper ? "tiles" : "cell");
     int64_t seed = s.get<int64_t>("seed", int64_t(p.seed));
     p.light_samples = s.get<int>("light_samples", p.light_samples);
     p.max_photon_depth = s.get<int>("max_photon_depth", p.max_photon_depth);
@@ -74,6 +76,15 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
         throw Error(where, "setting 'tile_shared' needs photon_map=hash_grid (it shares hash-grid cells), got " + map);
     if (p.share_tile < 1)
         throw Error(where, "setting 'share_tile' must be at least 1 pixel, got " + std::to_string(p.share_tile));
+    if (order != "cell" && order != "tiles")
+        throw Error(where, "setting 'gather_order' must be 'cell' or 'tiles', got '" + order + "'");
+    p.gather_by_tiles = order == "tiles";
+    if (order_given && !p.split)
+        throw Error(where, "setting 'gather_order' orders the gather pass of pass=split; got pass=" + pass);
+    if (p.tile_shared == TileShare::Paper && !p.gather_by_tiles)
+        throw Error(where, "setting 'tile_shared=paper' shares per screen tile, so it needs gather_order=tiles");
+    if (p.tile_shared == TileShare::CellGroups && p.gather_by_tiles)
+        throw Error(where, "setting 'tile_shared=cell_groups' groups hits sorted by cell, so it needs gather_order=cell");
     if (seed < 0) throw Error(where, "setting 'seed' must not be negative, got " + std::to_string(seed));
     p.seed = uint64_t(seed);
     if (p.light_samples < 0)
@@ -81,7 +92,7 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     if (p.max_photon_depth < 1)
         throw Error(where, "setting 'max_photon_depth' must be at least 1, got " + std::to_string(p.max_photon_depth));
     if (p.tile_size < 1) throw Error(where, "setting 'tile_size' must be at least 1, got " + std::to_string(p.tile_size));
-    if (p.tile_shared == TileShare::Paper && p.tile_size % p.share_tile != 0)
+    if ((p.tile_shared == TileShare::Paper || p.gather_by_tiles) && p.tile_size % p.share_tile != 0)
         throw Error(where, "setting 'tile_shared=paper' needs a tile_size that is a multiple of share_tile (share tiles "
                            "nest in render tiles), got tile_size " + std::to_string(p.tile_size) + " and share_tile " +
                                std::to_string(p.share_tile));

@@ -27,9 +27,12 @@
 // files still work: false = off, true = cell_groups), share_tile (8 pixels: P1 does not
 // give its thread-group size; tile_size must be a multiple of it with tile_shared=paper),
 // seed (1), light_samples (1), max_photon_depth (8: surface hits along a photon path),
-// tile_size (16). Primary rays go through pixel centres. With pass=split the gather pass
-// walks the hits sorted by cell, except with tile_shared=paper, where it walks the share
-// tiles (the paper's hybrid kernel: one thread group per tile).
+// tile_size (16). Primary rays go through pixel centres. gather_order (pass=split only):
+// cell (the gather pass walks the hits sorted by hash cell; the default, and what
+// cell_groups needs) | tiles (it walks the share tiles in image order, the paper's hybrid
+// kernel: one thread group per tile; what tile_shared=paper needs, and its default).
+// With tile_shared=off both orders give the same image, so the paper's sharing can be
+// timed against a per-hit gather walking the same tiles.
 //
 // Stereo (a two-view render): the right eye draws its light samples from the stream of
 // the left pixel that sees the same point, so both eyes show the same noise on a surface
@@ -83,6 +86,7 @@ struct PhotonMappingSettings {
     PhotonStorage storage = PhotonStorage::Indirect;
     TileShare tile_shared = TileShare::Off;
     int share_tile = 8;  // pixels square: the paper's thread-group tile (its size is not given)
+    bool gather_by_tiles = false;  // pass=split: walk share tiles in image order instead of hits sorted by cell
     uint64_t seed = 1;
     int light_samples = 1;
     int max_photon_depth = 8;

@@ -138,7 +138,12 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
                 points.push_back(h.valid ? &h.point : nullptr);
             }
         out.assign(points.size(), PhotonEstimate{});
-        gather_tile_paper(gatherer, points, out, scratch, qs, tc);
+        if (s.tile_shared == TileShare::Paper) {
+            gather_tile_paper(gatherer, points, out, scratch, qs, tc);
+        } else {
+            for (size_t i = 0; i < points.size(); ++i)
+                if (points[i]) out[i] = gatherer.estimate_parts(*points[i], scratch, qs);
+        }
         size_t i = 0;
         for (int y = t.y0; y < t.y1; ++y)
             for (int x = t.x0; x < t.x1; ++x, ++i) write_gather(pixel_index(x, y), out[i]);
@@ -261,7 +266,7 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
         });
         frame_stats.add("trace_pass_ms", trace_watch.elapsed_ms());
         Stopwatch gather_watch;
-        if (s.tile_shared == TileShare::Paper) {
+        if (s.gather_by_tiles) {
             // Pass 2 as the paper's gather kernel: one thread group per share tile.
             auto hit_of = [&](int x, int y) -> const HitRecord& { return hits[pixel_index(x, y)]; };
             parallel_for_tiles(width, height, s.share_tile, [&](const Tile& t) {
