@@ -2,22 +2,11 @@
 
 #include <cstdio>
 #include "core/error.hpp"
+#include "core/memory_budget.hpp"
 
 namespace gilab {
 
 namespace {
-
-std::string format_bytes(long double bytes) {
-    const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
-    int unit = 0;
-    while (bytes >= 1024.0L && unit < 6) {
-        bytes /= 1024.0L;
-        ++unit;
-    }
-    char buffer[64];
-    std::snprintf(buffer, sizeof buffer, "%.1Lf %s", bytes, units[unit]);
-    return buffer;
-}
 
 void check_pixel(const Film& film, const std::string& layer, int x, int y) {
     if (x < 0 || y < 0 || x >= film.width() || y >= film.height()) {
@@ -30,20 +19,18 @@ void check_pixel(const Film& film, const std::string& layer, int x, int y) {
 
 }  // namespace
 
-void check_resolution(int width, int height, int layers_hint, size_t max_bytes) {
+void check_resolution(int width, int height, int layers_hint) {
     std::string resolution = std::to_string(width) + "x" + std::to_string(height);
     if (width <= 0 || height <= 0) {
         throw Error("resolution " + resolution + " is invalid: width and height must be positive");
     }
     if (layers_hint < 1) layers_hint = 1;
-    // long double: 1e6 x 1e6 x 8 layers x 12 bytes overflows nothing here.
-    long double bytes = (long double)width * height * layers_hint * 3.0L * sizeof(float);
-    if (bytes > (long double)max_bytes) {
-        throw Error("resolution " + resolution + " would need " + format_bytes(bytes) + " (" +
-                    std::to_string((unsigned long long)std::min(bytes, 1.8e19L)) +
-                    " bytes) of float storage for " + std::to_string(layers_hint) +
-                    " RGB layers, more than the limit of " + format_bytes(max_bytes));
-    }
+    // Both factors are below 2^31, so their product and the saturating multiplications
+    // cannot wrap.
+    const uint64_t pixels = uint64_t(width) * uint64_t(height);
+    const uint64_t bytes = MemoryBudget::times(pixels, uint64_t(layers_hint) * 3 * sizeof(float));
+    MemoryBudget::check(bytes, std::to_string(layers_hint) + " RGB float layer(s) of " + resolution + " pixels",
+                        "resolution " + resolution);
 }
 
 Film::Film(int width, int height) : width_(width), height_(height) {

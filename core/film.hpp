@@ -41,8 +41,9 @@ private:
     std::map<std::string, Layer> layers_;
 };
 
-// Throws Error when width × height × channels is not sane (≤ 0, or more than
-// max_bytes of float storage): checked before anything is allocated.
-void check_resolution(int width, int height, int layers_hint = 8, size_t max_bytes = size_t(8) << 30);
+// Throws Error when width or height is not positive, or when `layers_hint` RGB float
+// layers of that size do not fit the memory budget (--memory-limit): checked before
+// anything is allocated.
+void check_resolution(int width, int height, int layers_hint = 8);
 
 }  // namespace gilab

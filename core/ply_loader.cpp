@@ -49,7 +49,14 @@ Scene load_ply_or_off(const fs::path& path) {
     std::vector<std::vector<size_t>> polygons;
     points.reserve(size_t(declared.vertices));
     polygons.reserve(size_t(declared.faces));
-    std::istringstream in(bytes, std::ios::in | std::ios::binary);
+    // gilab reads positions and faces only. CGAL's readers of OFF colours and texture
+    // coordinates index past the numbers a line holds when lines disagree with each
+    // other or with the header (found by fuzzing), so CGAL is given the keyword "OFF":
+    // it then reads the first three numbers of each vertex line and ignores the rest.
+    std::string plain_off;
+    if (declared.off_keyword_length > 3)
+        plain_off = std::string(bytes).replace(declared.off_keyword_offset, declared.off_keyword_length, "OFF");
+    std::istringstream in(plain_off.empty() ? bytes : plain_off, std::ios::in | std::ios::binary);
     const bool ok = ext == ".ply" ? CGAL::IO::read_PLY(in, points, polygons, CGAL::parameters::verbose(false))
                                   : CGAL::IO::read_OFF(in, points, polygons, CGAL::parameters::verbose(false));
     if (points.size() < declared.vertices || polygons.size() < declared.faces)

@@ -112,11 +112,47 @@ struct Element {
 
 enum class Format { Ascii, LittleEndian, BigEndian };
 
+// CGAL reads both spellings of the two elements.
+bool is_vertex_element(const Element& e) { return e.name == "vertex" || e.name == "vertices"; }
+bool is_face_element(const Element& e) { return e.name == "face" || e.name == "faces"; }
+
 bool is_face_list(const Element& e, const Property& p) {
-    return e.name == "face" && p.list && (p.name == "vertex_indices" || p.name == "vertex_index");
+    return is_face_element(e) && p.list && (p.name == "vertex_indices" || p.name == "vertex_index");
 }
 bool is_coordinate(const Element& e, const Property& p) {
-    return e.name == "vertex" && !p.list && (p.name == "x" || p.name == "y" || p.name == "z");
+    return is_vertex_element(e) && !p.list && (p.name == "x" || p.name == "y" || p.name == "z");
+}
+bool is_colour(const Property& p) {
+    return p.name == "red" || p.name == "green" || p.name == "blue" || p.name == "r" || p.name == "g" || p.name == "b";
+}
+bool is_uchar(const Property& p) { return !p.list && p.type.size == 1 && p.type.kind == Kind::Unsigned; }
+
+// CGAL looks the properties it reads up by name and casts them to the type it expects
+// without checking (a null pointer when the file disagrees, found by fuzzing): x, y, z
+// must be float or double, the face indices a list of integers, and when one colour
+// property is uchar (which makes CGAL read colours) all of them must be.
+void check_properties_cgal_reads(const Element& e, const std::string& where) {
+    if (!is_vertex_element(e) && !is_face_element(e)) return;
+    bool uchar_colour = false;
+    for (size_t i = 0; i < e.properties.size(); ++i) {
+        const Property& p = e.properties[i];
+        for (size_t j = 0; j < i; ++j)
+            if (e.properties[j].name == p.name)
+                throw Error(where, "element '" + e.name + "' declares property '" + p.name + "' twice");
+        uchar_colour = uchar_colour || (is_colour(p) && is_uchar(p));
+    }
+    for (const Property& p : e.properties) {
+        const bool coordinate_name = is_vertex_element(e) && (p.name == "x" || p.name == "y" || p.name == "z");
+        if (coordinate_name && (p.list || p.type.kind != Kind::Real))
+            throw Error(where, "vertex property '" + p.name + "' must be a float or double number (gilab reads "
+                               "real-valued coordinates only)");
+        const bool index_name = is_face_element(e) && (p.name == "vertex_indices" || p.name == "vertex_index");
+        if (index_name && (!p.list || p.type.kind == Kind::Real))
+            throw Error(where, "face property '" + p.name + "' must be a list of integers");
+        if (uchar_colour && is_colour(p) && !is_uchar(p))
+            throw Error(where, "element '" + e.name + "' mixes uchar and other colour properties ('" + p.name +
+                                   "' is not uchar); use one type for red, green and blue");
+    }
 }
 
 class PlyChecker {
@@ -177,8 +213,9 @@ private:
                 if (!has_format) throw Error(where, "malformed PLY: no 'format' line before 'end_header'");
                 data_ = pos;
                 for (const Element& e : elements_) {
-                    if (e.name == "vertex") counts_.vertices = e.count;
-                    if (e.name == "face") counts_.faces = e.count;
+                    check_properties_cgal_reads(e, file_);
+                    if (is_vertex_element(e)) counts_.vertices = e.count;
+                    if (is_face_element(e)) counts_.faces = e.count;
                 }
                 return;
             }
@@ -381,6 +418,8 @@ public:
                 throw Error(header_at, quote(t[0]) + " (homogeneous or n-dimensional OFF) is not supported; only 3D OFF");
             if (t.size() > 1 && t[1] == "BINARY") throw Error(header_at, "binary OFF is not supported; save the file as text OFF or PLY");
             first = 1;
+            keyword_offset_ = size_t(t[0].data() - bytes_.data());
+            keyword_length_ = t[0].size();
         }
         // The three counts, on the header line or the next ones.
         std::vector<std::string_view> header(t.begin() + long(first), t.end());
@@ -414,7 +453,7 @@ public:
                     throw Error(at, "vertex " + std::to_string(v) + " coordinate " + quote(t[k]) + " is not finite (non-finite vertex)");
             }
         }
-        PolygonFileCounts counts_out{vertices_, faces_, 0};
+        PolygonFileCounts counts_out{vertices_, faces_, 0, keyword_offset_, keyword_length_};
         for (uint64_t f = 0; f < faces_; ++f) {
             if (!next_line(t)) truncated("face " + std::to_string(f));
             const std::string at = at_line(line_no_);
@@ -454,6 +493,7 @@ private:
     const std::string& file_;
     size_t pos_ = 0, line_no_ = 0, line_start_ = 0;
     uint64_t vertices_ = 0, faces_ = 0;
+    size_t keyword_offset_ = 0, keyword_length_ = 0;
 
     std::string at_line(size_t line) const { return file_ + ":" + std::to_string(line); }
 

@@ -14,6 +14,10 @@ struct PolygonFileCounts {
     uint64_t vertices = 0;
     uint64_t faces = 0;
     uint64_t corners = 0;  // over all faces
+    // OFF only: where the header keyword (e.g. "COFF", "STNOFF") lies in the file, so the
+    // loader can hand CGAL a plain "OFF" (length 0 when the file has no keyword).
+    size_t off_keyword_offset = 0;
+    size_t off_keyword_length = 0;
 };
 
 PolygonFileCounts check_ply(const std::string& bytes, const std::string& file);

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <sstream>
+#include "core/input_file.hpp"
+#include "core/json_document.hpp"
 #include "core/rng.hpp"
 
 namespace gilab {
@@ -12,10 +14,24 @@ Settings::Settings(nlohmann::json values, std::string context)
     if (!values_.is_object()) throw Error(context_, "settings must be a JSON object, got " + values_.dump());
 }
 
+Settings Settings::from_file(const std::string& file) {
+    const std::string text = read_input_file(file);
+    check_text_encoding(text, file, "settings JSON");
+    return Settings(parse_json_document(text, file), file);
+}
+
 void Settings::set_from_string(const std::string& assignment) {
     auto eq = assignment.find('=');
     if (eq == std::string::npos || eq == 0)
         throw Error(context_, "setting '" + assignment + "' is not of the form key=value");
+    // Settings are JSON, whose strings are UTF-8; a stray byte would fail later, when
+    // the settings are hashed or written into an output's metadata.
+    try {
+        (void)nlohmann::json(assignment).dump();
+    } catch (const nlohmann::json::type_error&) {
+        throw Error(context_, "setting " + nlohmann::json(assignment).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) +
+                                  " is not valid UTF-8 text");
+    }
     std::string key = assignment.substr(0, eq);
     std::string text = assignment.substr(eq + 1);
     auto parsed = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);

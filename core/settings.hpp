@@ -14,6 +14,8 @@ class Settings {
 public:
     Settings() : values_(nlohmann::json::object()) {}
     explicit Settings(nlohmann::json values, std::string context = "settings");
+    // A settings file (a JSON object); errors name the file, the line and the key.
+    static Settings from_file(const std::string& file);
 
     // Parses "key=value"; value is read as JSON if it parses (numbers, true/false,
     // arrays), else as a string.

@@ -50,7 +50,9 @@ int write_html_report(const fs::path& results_root) {
     std::vector<fs::path> documents;
     std::error_code ec;
     for (const auto& entry : fs::directory_iterator(results_root, ec))
-        if (fs::exists(entry.path() / "results.json")) documents.push_back(entry.path() / "results.json");
+        // Hidden folders are runs in progress (or interrupted), not results.
+        if (entry.path().filename().string().rfind(".", 0) != 0 && fs::exists(entry.path() / "results.json"))
+            documents.push_back(entry.path() / "results.json");
     if (documents.empty()) throw Error(results_root.string(), "no results/*/results.json found (run `gilab experiment` first)");
     std::sort(documents.begin(), documents.end());
 

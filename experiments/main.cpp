@@ -6,6 +6,7 @@
 #include "core/memory_budget.hpp"
 #include "core/parallel.hpp"
 #include "experiments/experiment.hpp"
+#include "experiments/experiment_batch.hpp"
 #include "experiments/html_report.hpp"
 #include "experiments/render_command.hpp"
 #include "scenes/builtin_scenes.hpp"
@@ -39,38 +40,6 @@ void print_list(const std::string& what) {
             std::cout << "  " << p.name << " — " << p.display_name << ", " << p.width << "×" << p.height
                       << " per eye, IPD " << p.ipd * 1000 << " mm (" << p.source << ")\n";
     }
-}
-
-int run_experiments(const std::vector<std::string>& names, bool quick, const std::string& results, uint64_t seed,
-                    int threads, const AssetPaths& assets) {
-    const ExperimentRegistry& registry = ExperimentRegistry::builtin();
-    std::vector<const Experiment*> selected;
-    for (const auto& name : names) {
-        if (name == "all") {
-            for (const auto& e : registry.list()) selected.push_back(&e);
-        } else {
-            selected.push_back(&registry.get(name));  // throws on an unknown name, before running anything
-        }
-    }
-    int failures = 0;
-    for (const Experiment* e : selected) {
-        ExperimentContext ctx;
-        ctx.quick = quick;
-        ctx.output_dir = std::filesystem::path(results) / e->name;
-        ctx.assets = assets;
-        ctx.seed = seed;
-        ctx.threads = threads;
-        ctx.log = &std::cout;
-        std::cout << "experiment " << e->name << (quick ? " (quick)" : "") << ": " << e->description << std::endl;
-        try {
-            run_and_write(*e, ctx);
-            std::cout << "  wrote " << (ctx.output_dir / "table.md").string() << std::endl;
-        } catch (const Error& err) {
-            std::cerr << "gilab: experiment " << e->name << " failed: " << err.what() << std::endl;
-            ++failures;
-        }
-    }
-    return failures ? 1 : 0;
 }
 
 // --assets directories must exist (a typo would silently fall back to other copies of
@@ -176,6 +145,10 @@ int main(int argc, char** argv) {
     experiment->add_flag("--quick", quick, "small sizes (smoke run, minutes)");
     experiment->add_option("--results", results_dir, "results root directory")->capture_default_str();
     experiment->add_option("--seed", seed, "random seed")->capture_default_str();
+    bool resume = false;
+    experiment->add_flag("--resume", resume,
+                         "skip experiments whose results/NAME holds a finished run of this build with the same "
+                         "--quick, --seed and --threads (after an interrupted batch)");
 
     std::string report_dir = "results";
     auto* report = app.add_subcommand("report", "gather every results/NAME/results.json into results/report.html");
@@ -205,7 +178,22 @@ int main(int argc, char** argv) {
                 print_list("experiments");
                 return 0;
             }
-            return run_experiments(experiment_names, quick, results_dir, seed, threads, assets);
+            ExperimentBatch batch;
+            const ExperimentRegistry& registry = ExperimentRegistry::builtin();
+            for (const auto& name : experiment_names) {
+                if (name == "all") {
+                    for (const auto& e : registry.list()) batch.experiments.push_back(&e);
+                } else {
+                    batch.experiments.push_back(&registry.get(name));  // an unknown name stops before anything runs
+                }
+            }
+            batch.results_root = results_dir;
+            batch.quick = quick;
+            batch.resume = resume;
+            batch.seed = seed;
+            batch.threads = threads;
+            batch.assets = assets;
+            return run_experiment_batch(batch, std::cout, std::cerr);
         }
     } catch (const Error& e) {
         std::cerr << "gilab: error: " << e.what() << std::endl;

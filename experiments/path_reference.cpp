@@ -35,7 +35,9 @@ Film path_reference(const ExperimentContext& ctx, const Scene& scene, const EyeC
     if (!fs::exists(here) && fs::exists(ctx.output_dir.parent_path())) {
         for (const auto& entry : fs::directory_iterator(ctx.output_dir.parent_path(), ec)) {
             fs::path candidate = entry.path() / name;
-            if (entry.path().filename().string().rfind("pm-", 0) == 0 && fs::exists(candidate)) {
+            // The name holds the hash of everything the image depends on, so any
+            // finished experiment's copy will do (not the hidden staging folders).
+            if (entry.path().filename().string().rfind(".", 0) != 0 && fs::exists(candidate)) {
                 fs::copy_file(candidate, here, fs::copy_options::overwrite_existing, ec);
                 if (!ec) ctx.say("reference copied from " + candidate.string());
                 break;

@@ -11,8 +11,6 @@
 #include "core/film.hpp"
 #include "core/hmd.hpp"
 #include "core/image_io.hpp"
-#include "core/input_file.hpp"
-#include "core/json_document.hpp"
 #include "core/memory_budget.hpp"
 #include "core/mesh_topology.hpp"
 #include "experiments/result_writers.hpp"
@@ -27,16 +25,8 @@ namespace fs = std::filesystem;
 namespace {
 
 Settings read_settings(const RenderRequest& request) {
-    nlohmann::json values = nlohmann::json::object();
-    std::string context = "--set";
-    if (request.settings_file) {
-        const std::string& file = *request.settings_file;
-        const std::string text = read_input_file(file);
-        check_text_encoding(text, file, "settings JSON");
-        values = parse_json_document(text, file);
-        context = file;
-    }
-    Settings settings(values, context);
+    Settings settings = request.settings_file ? Settings::from_file(*request.settings_file)
+                                              : Settings(nlohmann::json::object(), "--set");
     for (const auto& a : request.assignments) settings.set_from_string(a);
     if (request.spp) settings.set("spp", *request.spp);
     settings.set("seed", request.seed);

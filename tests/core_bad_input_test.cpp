@@ -138,6 +138,11 @@ const BadCase kCases[] = {
     {"gltf_1_0_no_asset.gltf", {"glTF 1.0 is not supported"}},
     {"glb_version_1.glb", {"GLB version 1", "not supported"}},
     {"ply_version.ply", {":2:", "PLY version '2.0' is not supported"}},
+    // Properties CGAL would cast to the wrong type (null pointers, found by fuzzing).
+    {"ply_integer_coordinate.ply", {"vertex property 'x' must be a float or double"}},
+    {"ply_mixed_colour_types.ply", {"mixes uchar and other colour properties ('green'"}},
+    {"ply_duplicate_property.ply", {"declares property 'x' twice"}},
+    {"ply_real_face_indices.ply", {"face property 'vertex_indices' must be a list of integers"}},
     {"gltf_draco.gltf", {"/extensionsRequired/0", "Draco compression", "not supported"}},
     {"gltf_draco_not_required.gltf", {"/meshes/0/primitives/0", "Draco compression", "not supported"}},
     {"gltf_unknown_required_extension.gltf", {"required extension 'EXT_imaginary' is not supported"}},

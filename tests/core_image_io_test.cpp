@@ -9,6 +9,7 @@
 #include <map>
 #include <sstream>
 #include "core/error.hpp"
+#include "core/memory_budget.hpp"
 #include "core/image_io.hpp"
 #include "tests/test_support.hpp"
 
@@ -157,7 +158,17 @@ TEST(Film, CheckResolutionRejectsInsaneSizes) {
     std::string huge = error_of([] { check_resolution(1000000, 1000000); });
     EXPECT_NE(huge.find("1000000x1000000"), std::string::npos) << huge;
     EXPECT_NE(huge.find("96000000000000 bytes"), std::string::npos) << huge;  // 1e12 px * 8 * 12 B
-    EXPECT_THROW(check_resolution(100, 100, 8, 1000), Error);
+    {
+        // The budget decides: 100 × 100 × 8 layers × 12 B = 960 000 B.
+        ScopedMemoryLimit limit(959999);
+        std::string message = error_of([] { check_resolution(100, 100, 8); });
+        EXPECT_NE(message.find("960000 bytes"), std::string::npos) << message;
+        EXPECT_NE(message.find("--memory-limit"), std::string::npos) << message;
+    }
+    {
+        ScopedMemoryLimit limit(960000);
+        EXPECT_NO_THROW(check_resolution(100, 100, 8));
+    }
     EXPECT_THROW(Film(0, 5), Error);
     EXPECT_THROW(Film(1000000, 1000000), Error);  // refused before allocating
     EXPECT_THROW(Film(std::numeric_limits<int>::max(), std::numeric_limits<int>::max()), Error);

@@ -74,6 +74,19 @@ TEST(PlyLoader, OffRoundTrip) {
     check_pyramid(load_mesh_file(write_file(dir, "pyramid.off", kPyramidOff)));
 }
 
+// Colours, normals and texture coordinates are ignored, whatever their count per line:
+// CGAL's own colour reader indexed past the numbers of a vertex line without a colour.
+TEST(PlyLoader, OffVariantsReadPositionsWhateverTheirExtraNumbers) {
+    auto dir = test::temp_dir("off_variants");
+    const char* vertices = "0 0 0 255 0 0\n1 0 0\n1 1 0 7\n0 1 0 1 2\n0.5 0.5 1 0 0 255 255 9\n";
+    const char* faces = "4 0 3 2 1\n3 0 1 4 255 0 0\n3 1 2 4\n3 2 3 4 12\n3 3 0 4 1 2\n";
+    for (const char* keyword : {"COFF", "NOFF", "CNOFF", "STOFF", "STCNOFF"}) {
+        SCOPED_TRACE(keyword);
+        check_pyramid(load_mesh_file(write_file(dir, std::string(keyword) + ".off",
+                                                std::string(keyword) + "\n5 5 8\n" + vertices + faces)));
+    }
+}
+
 TEST(PlyLoader, MissingFile) {
     std::string msg = error_of([] { load_ply_or_off("/nonexistent/mesh.ply"); });
     EXPECT_NE(msg.find("mesh.ply"), std::string::npos) << msg;

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 #include <cmath>
 #include "core/settings.hpp"
+#include "tests/test_support.hpp"
 
 using namespace gilab;
 
@@ -34,6 +35,10 @@ TEST(Settings, ParsesAssignmentsAndRejectsWrongTypes) {
     EXPECT_EQ(s.get<std::string>("map", ""), "hash_grid");
     EXPECT_EQ(s.get<std::vector<int>>("flags", {}).size(), 2u);
     EXPECT_THROW(s.set_from_string("novalue"), Error);
+    // Settings are JSON text: a stray byte is refused when set, not when hashed.
+    const std::string message = test::error_of([&] { s.set_from_string("name=caf\xE9"); });
+    EXPECT_NE(message.find("not valid UTF-8"), std::string::npos) << message;
+    EXPECT_NO_THROW(s.hash());
     EXPECT_THROW(s.get<int>("map", 0), Error);
     EXPECT_THROW(s.require<int>("missing"), Error);
 }
