@@ -176,19 +176,21 @@ void append_bytes(void* context, void* data, int size) {
     out->append(static_cast<const char*>(data), size_t(size));
 }
 
+void check_exposure(const fs::path& path, float exposure) {
+    if (!std::isfinite(exposure)) throw Error(path.string(), "exposure must be finite");
+}
+
+}  // namespace
+
 void write_rgb_png(const fs::path& path, const std::vector<uint8_t>& rgb, int width, int height) {
+    if (width <= 0 || height <= 0 || rgb.size() != size_t(width) * size_t(height) * 3)
+        throw Error(path.string(), "PNG pixels do not match the " + std::to_string(width) + "x" + std::to_string(height) + " size");
     std::string encoded;
     if (!stbi_write_png_to_func(append_bytes, &encoded, width, height, 3, rgb.data(), width * 3)) {
         throw Error(path.string(), "PNG encoding failed");
     }
     write_file_atomically(path, encoded);
 }
-
-void check_exposure(const fs::path& path, float exposure) {
-    if (!std::isfinite(exposure)) throw Error(path.string(), "exposure must be finite");
-}
-
-}  // namespace
 
 void write_file_atomically(const fs::path& path, const std::string& contents) {
     TempFile temp(path);

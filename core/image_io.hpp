@@ -1,7 +1,9 @@
 #pragma once
 // Film output. Every writer writes to a temporary file in the target directory and
 // renames it into place, so an interrupted or failed write leaves no partial file.
+#include <cstdint>
 #include <filesystem>
+#include <vector>
 #include "core/film.hpp"
 
 namespace gilab {
@@ -25,6 +27,9 @@ void write_png(const std::filesystem::path& path, const Film& film, float exposu
                const std::string& layer = "color");
 void write_png_side_by_side(const std::filesystem::path& path, const Film& left,
                             const Film& right, float exposure = 0.0f);
+
+// An 8-bit RGB PNG of width × height pixels (rows top first), written atomically.
+void write_rgb_png(const std::filesystem::path& path, const std::vector<uint8_t>& rgb, int width, int height);
 
 // Atomic text/binary write (temp file + rename). Throws Error on failure.
 void write_file_atomically(const std::filesystem::path& path, const std::string& contents);

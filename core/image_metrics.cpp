@@ -6,10 +6,8 @@
 
 namespace gilab {
 
-namespace {
-
 // Both layers must exist with the same size and channel count.
-void check_comparable(const Film& a, const Film& b, const std::string& layer, const char* what) {
+void check_comparable_layers(const Film& a, const Film& b, const std::string& layer, const char* what) {
     if (a.width() != b.width() || a.height() != b.height()) {
         throw Error(what, "images differ in size: " + std::to_string(a.width()) + "x" +
                               std::to_string(a.height()) + " vs " + std::to_string(b.width()) +
@@ -26,11 +24,9 @@ void check_comparable(const Film& a, const Film& b, const std::string& layer, co
     }
 }
 
-}  // namespace
-
 double relative_mse(const Film& image, const Film& reference, const std::string& layer,
                     double epsilon) {
-    check_comparable(image, reference, layer, "relative_mse");
+    check_comparable_layers(image, reference, layer, "relative_mse");
     if (!(epsilon > 0.0)) throw Error("relative_mse", "epsilon must be positive");
     const auto& a = image.layer(layer).data;
     const auto& r = reference.layer(layer).data;
@@ -45,7 +41,7 @@ double relative_mse(const Film& image, const Film& reference, const std::string&
 
 double relative_mse_masked(const Film& image, const Film& reference, const std::vector<uint8_t>& mask,
                            const std::string& layer, double epsilon) {
-    check_comparable(image, reference, layer, "relative_mse_masked");
+    check_comparable_layers(image, reference, layer, "relative_mse_masked");
     if (!(epsilon > 0.0)) throw Error("relative_mse_masked", "epsilon must be positive");
     if (mask.size() != image.pixel_count())
         throw Error("relative_mse_masked", "mask has " + std::to_string(mask.size()) + " entries for " +
@@ -76,7 +72,7 @@ double mean_value(const Film& image, const std::string& layer) {
 }
 
 double max_abs_difference(const Film& a, const Film& b, const std::string& layer) {
-    check_comparable(a, b, layer, "max_abs_difference");
+    check_comparable_layers(a, b, layer, "max_abs_difference");
     const auto& x = a.layer(layer).data;
     const auto& y = b.layer(layer).data;
     double worst = 0.0;

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 #include "core/film.hpp"
+#include "core/image_plane.hpp"
 
 namespace gilab {
 
@@ -16,5 +17,35 @@ double relative_mse_masked(const Film& image, const Film& reference, const std::
                            const std::string& layer = "color", double epsilon = 1e-2);
 double mean_value(const Film& image, const std::string& layer = "color");  // over channels
 double max_abs_difference(const Film& a, const Film& b, const std::string& layer = "color");
+
+// Throws Error(what, ...) unless both films hold `layer` with the same size and channels.
+void check_comparable_layers(const Film& a, const Film& b, const std::string& layer, const char* what);
+
+// A per-pixel map of a perceptual metric and its mean over the image.
+struct MetricMap {
+    ImagePlane map;
+    double mean = 0.0;
+};
+
+// The perceptual metrics compare what a display shows: the layer's linear RGB scaled by
+// 2^exposure and clamped to [0, 1], as in the PNG previews (a 1-channel layer is grey).
+// NaN shows as magenta, as in the PNG previews.
+
+// SSIM (Wang, Bovik, Sheikh & Simoncelli 2004) of the sRGB-encoded luma (Rec. 709
+// weights): 11×11 Gaussian window with σ = 1.5 px, K1 = 0.01, K2 = 0.03, dynamic range 1,
+// edges clamped. 1 where the images agree; the mean is the usual SSIM index.
+MetricMap ssim_map(const Film& image, const Film& reference, const std::string& layer = "color",
+                   double exposure = 0.0);
+
+// FLIP (Andersson, Nilsson, Akenine-Möller, Oskarsson, Åström & Fairchild 2020), the LDR
+// version, written from the paper: colour pipeline (YCxCz, contrast-sensitivity filters,
+// Hunt-adjusted L*a*b*, HyAB distance, the qc/pc/pt remapping) and feature pipeline (edge
+// and point detectors on the achromatic channel), combined as ΔE_c^(1 − ΔE_f). 0 where
+// the images agree, 1 for the largest colour difference (green against blue); symmetric
+// in its two images. `pixels_per_degree` is the
+// viewing condition (67: a 0.7 m wide 4K monitor seen from 0.7 m, the paper's default).
+// Edges are clamped.
+MetricMap flip_map(const Film& image, const Film& reference, const std::string& layer = "color",
+                   double pixels_per_degree = 67.0, double exposure = 0.0);
 
 }  // namespace gilab

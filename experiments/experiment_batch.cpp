@@ -82,9 +82,12 @@ std::string describe_interruption(const ExperimentBatch& batch, const std::vecto
            list_names(kept) + ". Run the same command with --resume to skip them.\n";
 }
 
-// Moves the finished staging folder to `final_dir` in one step: an exchange when an
-// older run is there (then removed), a rename otherwise.
-void publish(const fs::path& staging, const fs::path& final_dir) {
+int resolved_threads(int threads) { return threads > 0 ? threads : int(default_thread_count()); }
+
+}  // namespace
+
+// An exchange when an older run is there (then removed), a rename otherwise.
+void publish_directory(const fs::path& staging, const fs::path& final_dir) {
     std::error_code ec;
     if (fs::exists(final_dir, ec)) {
         if (renameat2(AT_FDCWD, staging.c_str(), AT_FDCWD, final_dir.c_str(), RENAME_EXCHANGE) != 0)
@@ -94,10 +97,6 @@ void publish(const fs::path& staging, const fs::path& final_dir) {
         throw Error(final_dir.string(), std::string("cannot move the results into place: ") + std::strerror(errno));
     }
 }
-
-int resolved_threads(int threads) { return threads > 0 ? threads : int(default_thread_count()); }
-
-}  // namespace
 
 fs::path staging_directory(const fs::path& results_root, const std::string& name) {
     return results_root / ("." + name + ".partial");
@@ -152,7 +151,7 @@ int run_experiment_batch(const ExperimentBatch& batch, std::ostream& out, std::o
         out << "experiment " << e->name << (batch.quick ? " (quick)" : "") << ": " << e->description << std::endl;
         try {
             run_and_write(*e, ctx);
-            publish(staging, final_dir);
+            publish_directory(staging, final_dir);
             kept.push_back(e->name);
             set_interruption_message(describe_interruption(batch, kept, next));
             out << "  wrote " << (final_dir / "table.md").string() << std::endl;

@@ -30,6 +30,9 @@ struct ExperimentBatch {
 // Returns the exit code: 0, or 1 when an experiment failed (the others still run).
 int run_experiment_batch(const ExperimentBatch& batch, std::ostream& out, std::ostream& err);
 
+// Moves a finished staging folder to `final_dir` in one step, replacing an earlier one.
+void publish_directory(const std::filesystem::path& staging, const std::filesystem::path& final_dir);
+
 // The staging folder of one experiment's run in progress.
 std::filesystem::path staging_directory(const std::filesystem::path& results_root, const std::string& name);
 

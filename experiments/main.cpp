@@ -1,10 +1,12 @@
-// The gilab command line: render, info, list, experiment, report.
+// The gilab command line: render, info, list, compare, experiment, report.
 #include <CLI/CLI.hpp>
 #include <iostream>
+#include <sstream>
 #include "core/error.hpp"
 #include "core/hmd.hpp"
 #include "core/memory_budget.hpp"
 #include "core/parallel.hpp"
+#include "experiments/compare_command.hpp"
 #include "experiments/experiment.hpp"
 #include "experiments/experiment_batch.hpp"
 #include "experiments/html_report.hpp"
@@ -150,6 +152,33 @@ int main(int argc, char** argv) {
                          "skip experiments whose results/NAME holds a finished run of this build with the same "
                          "--quick, --seed and --threads (after an interrupted batch)");
 
+    CompareRequest compare_request;
+    std::vector<std::string> compare_settings, compare_assignments;
+    std::string compare_techniques = "path,photon,vct";
+    auto* compare = app.add_subcommand(
+        "compare", "render a scene with several techniques and compare each with a path-traced reference (time, "
+                   "memory, relMSE, SSIM, FLIP, heat maps) into RESULTS/compare/SCENE/");
+    compare->add_option("scene", compare_request.scene, "built-in name, scene file name in scenes/, or a path")->required();
+    compare->add_option("-t,--techniques", compare_techniques, "comma-separated techniques")->capture_default_str();
+    compare->add_option("--hmd", compare_request.hmd, "compare stereo pairs of this HMD preset");
+    compare->add_option("-W,--width", compare_request.width, "image (per-eye) width")->capture_default_str();
+    compare->add_option("-H,--height", compare_request.height, "image (per-eye) height")->capture_default_str();
+    compare->add_option("--reference-spp", compare_request.reference_spp,
+                        "samples per pixel of the path-traced reference (cached in RESULTS/compare/reference_cache)")
+        ->capture_default_str();
+    compare->add_option("--frames", compare_request.frames, "renders per technique; the median time is reported")
+        ->capture_default_str();
+    compare->add_option("--equal-time", compare_request.equal_time_seconds,
+                        "seconds per frame: scale each technique's quality setting (path spp, photon photons, vct "
+                        "diffuse_cones) until a frame takes about this long");
+    compare->add_option("--ppd", compare_request.pixels_per_degree,
+                        "FLIP viewing condition in pixels per degree (default 67, a monitor; with --hmd the headset's "
+                        "own: width / horizontal field of view)");
+    compare->add_option("--settings", compare_settings, "TECHNIQUE=FILE: a technique's settings as a JSON file (repeatable)");
+    compare->add_option("--set", compare_assignments, "TECHNIQUE:key=value: one technique setting (repeatable)");
+    compare->add_option("--results", compare_request.results, "results root directory")->capture_default_str();
+    compare->add_option("--seed", seed, "random seed")->capture_default_str();
+
     std::string report_dir = "results";
     auto* report = app.add_subcommand("report", "gather every results/NAME/results.json into results/report.html");
     report->add_option("--results", report_dir, "results root directory")->capture_default_str();
@@ -169,6 +198,26 @@ int main(int argc, char** argv) {
             std::cout << describe_scene(info_scene, assets);
         } else if (*list) {
             print_list(list_what);
+        } else if (*compare) {
+            compare_request.techniques.clear();
+            std::stringstream list(compare_techniques);
+            for (std::string t; std::getline(list, t, ',');)
+                if (!t.empty()) compare_request.techniques.push_back(t);
+            for (const auto& s : compare_settings) {
+                const auto eq = s.find('=');
+                if (eq == std::string::npos || eq == 0) throw Error("--settings", "'" + s + "' is not TECHNIQUE=FILE");
+                compare_request.settings_files[s.substr(0, eq)] = s.substr(eq + 1);
+            }
+            for (const auto& a : compare_assignments) {
+                const auto colon = a.find(':');
+                if (colon == std::string::npos || colon == 0) throw Error("--set", "'" + a + "' is not TECHNIQUE:key=value");
+                compare_request.assignments[a.substr(0, colon)].push_back(a.substr(colon + 1));
+            }
+            compare_request.seed = seed;
+            compare_request.threads = threads;
+            compare_request.assets = assets;
+            const std::string folder = run_compare(compare_request);
+            std::cout << "wrote " << folder << "/index.html\n";
         } else if (*report) {
             int n = write_html_report(report_dir);
             std::cout << "wrote " << (std::filesystem::path(report_dir) / "report.html").string() << " (" << n

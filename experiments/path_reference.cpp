@@ -12,8 +12,8 @@ namespace gilab {
 namespace fs = std::filesystem;
 
 Film path_reference(const ExperimentContext& ctx, const Scene& scene, const EyeCamera& camera, int spp,
-                     std::vector<std::string>& files) {
-    nlohmann::json settings = {{"spp", spp}, {"seed", ctx.seed}, {"max_depth", 8}, {"jitter", false}};
+                     std::vector<std::string>& files, bool jitter) {
+    nlohmann::json settings = {{"spp", spp}, {"seed", ctx.seed}, {"max_depth", 8}, {"jitter", jitter}};
     // The key: the scene's content, every setting given to the path tracer (the rest are
     // its defaults, which are part of its code), the digest of the path tracer's code,
     // and the camera.

@@ -12,8 +12,9 @@
 
 namespace gilab {
 
-// Adds the reference's file name to `files`.
+// Adds the reference's file name to `files`. `jitter` spreads each pixel's samples over
+// its area (an anti-aliased reference, for techniques that sample pixels the same way).
 Film path_reference(const ExperimentContext& ctx, const Scene& scene, const EyeCamera& camera, int spp,
-                    std::vector<std::string>& files);
+                    std::vector<std::string>& files, bool jitter = false);
 
 }  // namespace gilab

@@ -33,12 +33,6 @@ Settings read_settings(const RenderRequest& request) {
     return settings;
 }
 
-// Head pose when the scene gives none: the mono camera's position and orientation.
-HeadPose pose_from_camera(const SceneCamera& c) {
-    EyeCamera eye = EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, 1, 1);
-    return {eye.position(), eye.orientation()};
-}
-
 struct TracePlan {
     std::string path;
     std::vector<HeadPoseSample> trace;
@@ -247,6 +241,11 @@ std::vector<std::string> render_sequence(const TracePlan& plan, Technique& techn
 }
 
 }  // namespace
+
+HeadPose pose_from_camera(const SceneCamera& c) {
+    EyeCamera eye = EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, 1, 1);
+    return {eye.position(), eye.orientation()};
+}
 
 std::vector<std::string> run_render(const RenderRequest& request) {
     check_options(request);

@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 #include "core/asset_paths.hpp"
+#include "core/hmd.hpp"
+#include "core/scene.hpp"
 
 namespace gilab {
 
@@ -32,6 +34,9 @@ struct RenderRequest {
 // Renders and writes OUTPUT.exr and OUTPUT.png; returns the paths written. With a head
 // trace: OUTPUT_0000.exr/.png per frame and OUTPUT_frames.csv (head pose, render time).
 std::vector<std::string> run_render(const RenderRequest& request);
+
+// Head pose when the scene gives none: the mono camera's position and orientation.
+HeadPose pose_from_camera(const SceneCamera& camera);
 
 // `gilab info`: a human-readable summary of a scene.
 std::string describe_scene(const std::string& spec, const AssetPaths& assets);
