@@ -429,6 +429,11 @@ public:
             header.insert(header.end(), more.begin(), more.end());
         }
         const std::string where = at_line(line_no_);
+        // CGAL reads the counts as numbers and then the rest of their line as the first
+        // record, so anything after the third count would become a face (found by fuzzing).
+        if (header.size() > 3)
+            throw Error(where, "malformed OFF: " + quote(header[3]) +
+                                   " follows the vertex, face and edge counts on their line");
         const char* names[] = {"vertex", "face", "edge"};
         uint64_t counts[3];
         for (int k = 0; k < 3; ++k) {

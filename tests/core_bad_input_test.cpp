@@ -139,6 +139,7 @@ const BadCase kCases[] = {
     {"glb_version_1.glb", {"GLB version 1", "not supported"}},
     {"ply_version.ply", {":2:", "PLY version '2.0' is not supported"}},
     // Properties CGAL would cast to the wrong type (null pointers, found by fuzzing).
+    {"off_counts_line_extra_numbers.off", {":2:", "'3' follows the vertex, face and edge counts"}},
     {"ply_integer_coordinate.ply", {"vertex property 'x' must be a float or double"}},
     {"ply_mixed_colour_types.ply", {"mixes uchar and other colour properties ('green'"}},
     {"ply_duplicate_property.ply", {"declares property 'x' twice"}},
