@@ -38,6 +38,8 @@ public:
         return convert<T>(key);
     }
 
+    // Whether get or require has asked for `key` (present or not).
+    bool was_read(const std::string& key) const { return read_.count(key) != 0; }
     // Throws Error listing every key that was never read.
     void report_unused() const;
     const nlohmann::json& json() const { return values_; }

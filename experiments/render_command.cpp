@@ -282,6 +282,11 @@ std::vector<std::string> run_render(const RenderRequest& request) {
     }
 
     technique->prepare(scene, settings);
+    // --spp is stored as the setting 'spp'; a technique that never asks for it takes no
+    // pixel samples, which is the option's fault, not an unknown --set key.
+    if (request.spp && !settings.was_read("spp"))
+        throw Error("--spp", "technique '" + technique->name() +
+                                 "' takes no pixel samples (it reads no setting 'spp'); leave --spp out");
     settings.report_unused();
     if (plan) return render_sequence(*plan, *technique, *rig, opened, settings, request);
 

@@ -256,3 +256,23 @@ TEST(Cli, RendersShadowsFromEveryStructure) {
     expect_failure("render fbm_terrain -t dag_shadows --set visibility=shadowmap -W 32 -H 32 -o " + (bad / "x").string(),
                    {"dag_shadows.visibility", "shadowmap"}, bad);
 }
+
+TEST(Cli, PhotonTakesPixelSamplesAndTechniquesWithoutThemRefuseSpp) {
+    const fs::path dir = gilab::test::temp_dir("cli_photon_spp");
+    const std::string size = " -W 16 -H 16 --set photons=4096";
+    const Result four = run("render cornell -t photon --spp 4" + size + " -o " + (dir / "four").string());
+    ASSERT_EQ(four.exit_code, 0) << four.output;
+    const Result one = run("render cornell -t photon --spp 1" + size + " -o " + (dir / "one").string());
+    ASSERT_EQ(one.exit_code, 0) << one.output;
+    gilab::Film film = gilab::read_exr(dir / "four.exr");
+    EXPECT_EQ(film.metadata["spp"], "4");
+    EXPECT_EQ(gilab::read_exr(dir / "one.exr").metadata["spp"], "1");
+    EXPECT_NE(color_of(film), color_of(gilab::read_exr(dir / "one.exr")));
+
+    // vct reads no 'spp': the error names the option, not an unknown --set key.
+    const fs::path bad = gilab::test::temp_dir("cli_vct_spp");
+    const std::string args = "render cornell -t vct --spp 4 -W 8 -H 8 --set levels=2 --set resolution=8 -o " +
+                             (bad / "x").string();
+    expect_failure(args, {"--spp", "'vct' takes no pixel samples"}, bad);
+    EXPECT_FALSE(contains(run(args).output, "unknown setting")) << run(args).output;
+}

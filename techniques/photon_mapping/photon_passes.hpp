@@ -10,14 +10,30 @@
 
 namespace gilab {
 
-// The left eye's hits, kept for the right eye (stereo reuse).
+// The left eye's hits, kept for the right eye (stereo reuse): every sample of every left
+// pixel, sample-major (slot = sample · pixels + pixel), so each sample's hits form one
+// image-sized layer for the claims, with their light samples and final radiance.
 struct PhotonMappingTechnique::KeptHits {
-    std::vector<PrimaryHit> hits;              // one per left pixel
-    std::vector<LightSampleRecord> samples;    // light_samples per left pixel
-    size_t per_pixel = 0;
-    std::span<const LightSampleRecord> samples_of(size_t pixel) const {
-        return {samples.data() + pixel * per_pixel, per_pixel};
+    std::vector<PrimaryHit> hits;
+    std::vector<LightSampleRecord> samples;  // per_hit per hit
+    std::vector<Vec3> direct, indirect;      // the left eye's radiance of each hit's sample
+    size_t pixels = 0;
+    size_t per_hit = 0;
+    int spp = 1;
+
+    // Kept from frame to frame: every slot is overwritten, so no clearing.
+    void resize(size_t pixel_count, int samples_per_pixel, size_t light_samples) {
+        pixels = pixel_count, spp = samples_per_pixel, per_hit = light_samples;
+        const size_t n = pixels * size_t(spp);
+        hits.resize(n);
+        samples.resize(n * per_hit);
+        direct.resize(n);
+        indirect.resize(n);
     }
+    size_t slot(size_t pixel, int sample) const { return size_t(sample) * pixels + pixel; }
+    std::span<const PrimaryHit> layer(int sample) const { return {hits.data() + slot(0, sample), pixels}; }
+    std::span<LightSampleRecord> samples_of(size_t slot) { return {samples.data() + slot * per_hit, per_hit}; }
+    std::span<const LightSampleRecord> samples_of(size_t slot) const { return {samples.data() + slot * per_hit, per_hit}; }
 };
 
 // What one view's render needs beyond its camera.
@@ -26,17 +42,6 @@ struct PhotonMappingTechnique::ViewOptions {
     const EyeCamera* stream_eye = nullptr;   // stereo right eye: key by the left pixel seeing the point
     KeptHits* keep = nullptr;                // keep every hit (left eye of a reusing stereo render)
 };
-
-// The light-sample stream of a hit seen by `pixel` of view `view`: its own pixel's, or,
-// when `stream_eye` is given (a stereo right eye, with the left eye), the stream of the
-// left pixel that sees the same point, so both eyes draw the same samples there.
-inline Rng light_sample_stream(uint64_t seed, const EyeCamera* stream_eye, const Vec3& x, uint32_t pixel,
-                               uint64_t view) {
-    if (stream_eye)
-        if (auto q = stream_eye->pixel_of(x))
-            return Rng::for_sample(seed, uint64_t(q->y) * uint64_t(stream_eye->width()) + uint64_t(q->x), 0, 0);
-    return Rng::for_sample(seed, pixel, 0, view);
-}
 
 // A non-finite radiance is counted and written as black.
 inline Vec3 finite_or_zero(const Vec3& v, std::atomic<uint64_t>& nonfinite) {

@@ -27,6 +27,10 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     p.light_samples = s.get<int>("light_samples", p.light_samples);
     p.max_photon_depth = s.get<int>("max_photon_depth", p.max_photon_depth);
     p.tile_size = s.get<int>("tile_size", p.tile_size);
+    p.sampling.spp = s.get<int>("spp", p.sampling.spp);
+    // Jittered by default only with several samples: one sample stays at the pixel centre,
+    // the image of the one-ray-per-pixel technique.
+    p.sampling.jitter = s.get<bool>("jitter", p.sampling.spp > 1);
     p.stereo.enabled = s.get<bool>("stereo_reuse", p.stereo.enabled);
     std::string match = s.get<std::string>("stereo_match", to_string(p.stereo.match));
     p.stereo.tolerance = s.get<float>("stereo_tolerance", p.stereo.tolerance);
@@ -92,6 +96,10 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     if (p.max_photon_depth < 1)
         throw Error(where, "setting 'max_photon_depth' must be at least 1, got " + std::to_string(p.max_photon_depth));
     if (p.tile_size < 1) throw Error(where, "setting 'tile_size' must be at least 1, got " + std::to_string(p.tile_size));
+    if (p.sampling.spp < 1) throw Error(where, "setting 'spp' must be at least 1, got " + std::to_string(p.sampling.spp));
+    if (p.sampling.spp > kMaxPhotonSpp)
+        throw Error(where, "setting 'spp' must be at most " + std::to_string(kMaxPhotonSpp) + ", got " +
+                               std::to_string(p.sampling.spp));
     if ((p.tile_shared == TileShare::Paper || p.gather_by_tiles) && p.tile_size % p.share_tile != 0)
         throw Error(where, "setting 'tile_shared=paper' needs a tile_size that is a multiple of share_tile (share tiles "
                            "nest in render tiles), got tile_size " + std::to_string(p.tile_size) + " and share_tile " +

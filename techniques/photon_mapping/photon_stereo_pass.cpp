@@ -1,8 +1,10 @@
 // The right eye of a reusing stereo render: claims by the left eye's hits
-// (stereo_reuse.hpp), then every right pixel either composes the claiming hit's
+// (stereo_reuse.hpp), then every right sample either composes the claiming hit's
 // view-independent shading with its own glossy lobe, or is shaded as an independent eye
 // (its own gather per hit; with every-hit storage the map's first-hit part is its direct
-// light, as in the left eye).
+// light, as in the left eye). With spp samples per pixel the reuse runs per sample: sample
+// s of the left pixels (one image-sized layer of hits) claims and fills sample s of the
+// right pixels, and each right pixel averages its samples as the left eye does.
 #include <mutex>
 #include <optional>
 #include "core/interaction.hpp"
@@ -13,11 +15,18 @@
 namespace gilab {
 
 void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const EyeCamera& right, const KeptHits& kept,
-                                                  const Film& left_film, Film& film, PhotonQueryStats& query_stats,
-                                                  Stats& frame_stats) const {
+                                                  Film& film, PhotonQueryStats& query_stats, Stats& frame_stats) const {
     const PhotonMappingSettings& s = settings_;
+    const int spp = s.sampling.spp;
     Stopwatch claim_watch;
-    const StereoClaims claims(kept.hits, left, right, scene_.tracer());
+    check_sample_memory(right.width(), right.height(), spp, sizeof(uint32_t), "the right eye's claims", "photon");
+    std::vector<StereoClaims> claims;
+    claims.reserve(size_t(spp));
+    StereoClaimStats claim_stats;
+    for (int sample = 0; sample < spp; ++sample) {
+        claims.emplace_back(kept.layer(sample), left, right, scene_.tracer());
+        claim_stats.merge(claims.back().stats());
+    }
     frame_stats.add("claim_ms", claim_watch.elapsed_ms());
 
     Stopwatch right_watch;
@@ -25,8 +34,6 @@ void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const E
     const PhotonGatherer gatherer(*map_, scene_.materials(), s.gather, s.radius, size_t(s.k));
     const PrimaryShadingContext shading{scene_.tracer(), scene_.frame(), scene_.materials(), scene_.lights(),
                                         s.light_samples};
-    const float* left_direct = left_film.layer("direct").data.data();
-    const float* left_indirect = left_film.layer("indirect").data.data();
     float* direct = film.layer("direct").data.data();
     float* indirect = film.layer("indirect").data.data();
     float* reused_layer = film.add_layer("reused", 1).data.data();
@@ -36,78 +43,85 @@ void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const E
     std::mutex merge;
     std::atomic<uint64_t> nonfinite{0}, reused{0}, reshaded_glossy{0}, strict_rejected{0}, shaded{0}, filled{0};
 
-    auto load = [](const float* layer, size_t pixel) {
-        return Vec3(layer[3 * pixel], layer[3 * pixel + 1], layer[3 * pixel + 2]);
-    };
-
     parallel_for_tiles(width, right.height(), s.tile_size, [&](const Tile& tile) {
         GatherScratch scratch;
         PhotonQueryStats qs;
         std::vector<LightSampleRecord> samples(size_t(std::max(s.light_samples, 0)));
+        std::vector<Vec3> sample_direct(static_cast<size_t>(spp)), sample_indirect(static_cast<size_t>(spp));
         uint64_t n_reused = 0, n_glossy = 0, n_rejected = 0, n_shaded = 0, n_filled = 0;
         for (int y = tile.y0; y < tile.y1; ++y)
             for (int x = tile.x0; x < tile.x1; ++x) {
                 const uint32_t pixel = uint32_t(size_t(y) * size_t(width) + size_t(x));
-                Vec3 Ld(0.0f), Li(0.0f);
-                uint32_t source = claims.source(pixel);
-                bool from_left = source != StereoClaims::kNone;
-                std::optional<SurfaceInteraction> own;  // the right pixel's own hit, if traced
-                if (!from_left || s.stereo.match == StereoMatch::Strict) {
-                    Ray ray = right.generate_ray(float(x) + 0.5f, float(y) + 0.5f);
-                    Hit hit = scene_.tracer().intersect(ray);
-                    if (hit.valid()) own = make_interaction(scene_.frame(), ray, hit);
-                    PrimaryHit mine;
-                    if (own) mine = primary_hit_of(*own, scene_.materials()[own->material]);
-                    if (from_left) {
-                        from_left = same_surface_point(kept.hits[source], mine, right, s.stereo.tolerance);
-                        n_rejected += !from_left;
-                    } else if (own && s.stereo.fill && s.stereo.match == StereoMatch::Nearest) {
-                        source = crack_fill_source(claims, kept.hits, mine, right, x, y);
-                        from_left = source != StereoClaims::kNone;
-                        n_filled += from_left;
-                    }
-                }
-                if (from_left) {
-                    const PrimaryHit& h = kept.hits[source];
-                    const Material& m = scene_.materials()[h.point.material];
-                    if (s.stereo.reshade && map_direct && !m.has_glossy_lobe()) {
-                        // Every-hit storage, Lambertian: the left eye's light is view-independent.
-                        Ld = load(left_direct, source);
-                        Li = load(left_indirect, source);
-                    } else if (s.stereo.reshade) {
-                        // View-independent parts from the left eye; the glossy lobe for this eye.
-                        const Vec3 wo = glm::normalize(eye - h.point.position);
-                        Ld = direct_radiance(m, h, wo, kept.samples_of(source));
-                        if (m.has_glossy_lobe()) {
-                            GatherPoint p = h.point;
-                            p.wo = wo;
-                            const PhotonEstimate e = gatherer.estimate_parts(p, scratch, qs);
-                            Li = e.indirect;
-                            if (map_direct) Ld += e.direct;
-                            ++n_glossy;
-                        } else {
-                            Li = load(left_indirect, source);
+                int pixel_reused = 0;
+                for (int sample = 0; sample < spp; ++sample) {
+                    const StereoClaims& layer = claims[size_t(sample)];
+                    Vec3 Ld(0.0f), Li(0.0f);
+                    uint32_t source = layer.source(pixel);  // a left pixel, its hit in this sample's layer
+                    bool from_left = source != StereoClaims::kNone;
+                    std::optional<SurfaceInteraction> own;  // the right sample's own hit, if traced
+                    if (!from_left || s.stereo.match == StereoMatch::Strict) {
+                        const Vec2 at = Vec2(float(x), float(y)) + sample_offset(s.sampling, s.seed, pixel, sample, 1);
+                        Ray ray = right.generate_ray(at.x, at.y);
+                        Hit hit = scene_.tracer().intersect(ray);
+                        if (hit.valid()) own = make_interaction(scene_.frame(), ray, hit);
+                        PrimaryHit mine;
+                        if (own) mine = primary_hit_of(*own, scene_.materials()[own->material]);
+                        if (from_left) {
+                            from_left = same_surface_point(kept.hits[kept.slot(source, sample)], mine, right,
+                                                           s.stereo.tolerance);
+                            n_rejected += !from_left;
+                        } else if (own && s.stereo.fill && s.stereo.match == StereoMatch::Nearest) {
+                            source = crack_fill_source(layer, kept.layer(sample), mine, right, x, y);
+                            from_left = source != StereoClaims::kNone;
+                            n_filled += from_left;
                         }
-                    } else {
-                        Ld = load(left_direct, source);
-                        Li = load(left_indirect, source);
                     }
-                    ++n_reused;
-                    reused_layer[pixel] = 1.0f;
-                } else if (own) {
-                    // Nobody claimed it (or strict mode refused): shade it as an independent eye.
-                    const Material& m = scene_.materials()[own->material];
-                    PrimaryHit ph = primary_hit_of(*own, m);
-                    Rng rng = light_sample_stream(s.seed, &left, own->position, pixel, 1);
-                    sample_direct_light(shading, *own, rng, samples, ph);
-                    Ld = direct_radiance(m, ph, own->wo, samples);
-                    const PhotonEstimate e = gatherer.estimate_parts(ph.point, scratch, qs);
-                    Li = e.indirect;
-                    if (map_direct) Ld += e.direct;
-                    ++n_shaded;
+                    if (from_left) {
+                        const size_t k = kept.slot(source, sample);
+                        const PrimaryHit& h = kept.hits[k];
+                        const Material& m = scene_.materials()[h.point.material];
+                        if (s.stereo.reshade && map_direct && !m.has_glossy_lobe()) {
+                            // Every-hit storage, Lambertian: the left eye's light is view-independent.
+                            Ld = kept.direct[k];
+                            Li = kept.indirect[k];
+                        } else if (s.stereo.reshade) {
+                            // View-independent parts from the left eye; the glossy lobe for this eye.
+                            const Vec3 wo = glm::normalize(eye - h.point.position);
+                            Ld = direct_radiance(m, h, wo, kept.samples_of(k));
+                            if (m.has_glossy_lobe()) {
+                                GatherPoint p = h.point;
+                                p.wo = wo;
+                                const PhotonEstimate e = gatherer.estimate_parts(p, scratch, qs);
+                                Li = e.indirect;
+                                if (map_direct) Ld += e.direct;
+                                ++n_glossy;
+                            } else {
+                                Li = kept.indirect[k];
+                            }
+                        } else {
+                            Ld = kept.direct[k];
+                            Li = kept.indirect[k];
+                        }
+                        ++n_reused;
+                        ++pixel_reused;
+                    } else if (own) {
+                        // Nobody claimed it (or strict mode refused): shade it as an independent eye.
+                        const Material& m = scene_.materials()[own->material];
+                        PrimaryHit ph = primary_hit_of(*own, m);
+                        Rng rng = light_sample_stream(s.sampling, s.seed, &left, own->position, pixel, sample, 1);
+                        sample_direct_light(shading, *own, rng, samples, ph);
+                        Ld = direct_radiance(m, ph, own->wo, samples);
+                        const PhotonEstimate e = gatherer.estimate_parts(ph.point, scratch, qs);
+                        Li = e.indirect;
+                        if (map_direct) Ld += e.direct;
+                        ++n_shaded;
+                    }
+                    sample_direct[size_t(sample)] = finite_or_zero(Ld, nonfinite);
+                    sample_indirect[size_t(sample)] = finite_or_zero(Li, nonfinite);
                 }
-                write_pixel(direct, pixel, finite_or_zero(Ld, nonfinite));
-                write_pixel(indirect, pixel, finite_or_zero(Li, nonfinite));
+                write_pixel(direct, pixel, sample_mean(sample_direct));
+                write_pixel(indirect, pixel, sample_mean(sample_indirect));
+                reused_layer[pixel] = float(pixel_reused) / float(spp);
             }
         reused += n_reused, reshaded_glossy += n_glossy, strict_rejected += n_rejected, shaded += n_shaded;
         filled += n_filled;
@@ -117,18 +131,17 @@ void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const E
     float* color = film.layer("color").data.data();
     for (size_t i = 0; i < 3 * film.pixel_count(); ++i) color[i] = direct[i] + indirect[i];
     frame_stats.add("right_pass_ms", right_watch.elapsed_ms());
-    const StereoClaimStats& c = claims.stats();
-    frame_stats.set("reuse_left_hits", double(c.left_hits));
-    frame_stats.set("reuse_back_side", double(c.back_side));
-    frame_stats.set("reuse_outside", double(c.outside));
-    frame_stats.set("reuse_occluded", double(c.occluded));
-    frame_stats.set("reuse_candidates", double(c.candidates));
-    frame_stats.set("reuse_claimed_pixels", double(c.claimed_pixels));
-    frame_stats.set("reuse_depth_conflicts", double(c.depth_conflicts));
+    frame_stats.set("reuse_left_hits", double(claim_stats.left_hits));
+    frame_stats.set("reuse_back_side", double(claim_stats.back_side));
+    frame_stats.set("reuse_outside", double(claim_stats.outside));
+    frame_stats.set("reuse_occluded", double(claim_stats.occluded));
+    frame_stats.set("reuse_candidates", double(claim_stats.candidates));
+    frame_stats.set("reuse_claimed_pixels", double(claim_stats.claimed_pixels));
+    frame_stats.set("reuse_depth_conflicts", double(claim_stats.depth_conflicts));
     frame_stats.set("reuse_strict_rejected", double(strict_rejected.load()));
     frame_stats.set("reused_pixels", double(reused.load()));
     frame_stats.set("reuse_crack_filled", double(filled.load()));
-    // Of the right pixels that show geometry (reused or shaded), the share reused.
+    // Of the right samples that show geometry (reused or shaded), the share reused.
     const double covered = double(reused.load() + shaded.load());
     frame_stats.set("reuse_fraction", covered > 0 ? double(reused.load()) / covered : 0.0);
     frame_stats.set("reuse_reshaded_glossy", double(reshaded_glossy.load()));

@@ -87,15 +87,17 @@ void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& fil
     const bool stereo = views.stereo();
     const bool reuse = stereo && settings_.stereo.enabled;
     if (reuse && !kept_) kept_ = std::make_unique<KeptHits>();
+    double samples = 0;  // primary rays' samples, all views
     for (size_t v = 0; v < views.views.size(); ++v) {
         const EyeCamera& camera = views.views[v];
         check_resolution(camera.width(), camera.height(), 4);
         Film film(camera.width(), camera.height());
+        samples += double(film.pixel_count()) * double(settings_.sampling.spp);
         film.add_layer("direct");
         film.add_layer("indirect");
         Stopwatch view_watch;
         if (reuse && v == 1) {
-            render_right_reusing(views.views[0], camera, *kept_, films[0], film, queries, frame);
+            render_right_reusing(views.views[0], camera, *kept_, film, queries, frame);
         } else {
             ViewOptions options;
             options.view = v;
@@ -114,6 +116,8 @@ void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& fil
         film.metadata["photon_storage"] = to_string(settings_.storage);
         film.metadata["tile_shared"] = to_string(settings_.tile_shared);
         film.metadata["seed"] = std::to_string(settings_.seed);
+        film.metadata["spp"] = std::to_string(settings_.sampling.spp);
+        film.metadata["jitter"] = settings_.sampling.jitter ? "true" : "false";
         if (stereo) film.metadata["stereo_reuse"] = reuse ? to_string(settings_.stereo.match) : "off";
         film.metadata["config_hash"] = config_hash_;
         film.metadata["git_revision"] = GILAB_GIT_REVISION;
@@ -131,6 +135,8 @@ void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& fil
                             "right_shaded_pixels"})
         stats_.set(key, frame.get(key));
     stats_.set("render_ms", ms);
+    stats_.set("spp", double(settings_.sampling.spp));
+    stats_.set("samples", samples);
     stats_.set("gather_queries", double(queries.queries));
     stats_.set("photons_visited", double(queries.visited));
     stats_.set("photons_inside", double(queries.inside));

@@ -27,7 +27,12 @@
 // files still work: false = off, true = cell_groups), share_tile (8 pixels: P1 does not
 // give its thread-group size; tile_size must be a multiple of it with tile_shared=paper),
 // seed (1), light_samples (1), max_photon_depth (8: surface hits along a photon path),
-// tile_size (16). Primary rays go through pixel centres. gather_order (pass=split only):
+// tile_size (16), spp (1: primary rays per pixel, each with its own light samples, all
+// gathering from the frame's one photon map; every layer is the samples' mean; at most
+// 1024), jitter (true when spp > 1: positions uniform in the pixel | false: pixel
+// centres, so the default image is the one-ray-per-pixel render; pixel_samples.hpp).
+// Tile sharing and the split pass take a pixel's samples as more hits; stereo reuse and
+// foveation work per sample index (below). gather_order (pass=split only):
 // cell (the gather pass walks the hits sorted by hash cell; the default, and what
 // cell_groups needs) | tiles (it walks the share tiles in image order, the paper's hybrid
 // kernel: one thread group per tile; what tile_shared=paper needs, and its default).
@@ -43,8 +48,9 @@
 // footprints), stereo_reshade (true: re-evaluate the glossy lobe for the right eye;
 // false: copy the left colour, the paper's behaviour), stereo_fill (false: true fills
 // one-pixel reprojection cracks from neighbouring claims, nearest mode only). The right
-// film gets a "reused" layer (1 where the pixel came from the left eye); its unclaimed
-// pixels gather per hit whatever tile_shared says. With photon_storage=every_hit a
+// film gets a "reused" layer (the share of the pixel's samples that came from the left
+// eye; with spp > 1 sample s of the left pixels claims sample s of the right pixels); its
+// unclaimed pixels gather per hit whatever tile_shared says. With photon_storage=every_hit a
 // reshaded glossy pixel re-gathers both parts of the estimate for the right eye's
 // direction, a Lambertian one copies the left eye's direct and indirect light.
 //
@@ -53,7 +59,7 @@
 // Needs pass=fused, tile_shared=off, photon_storage=indirect (it keeps direct light per
 // pixel by shadow rays and shares only gathered indirect light) and a tile_size that is
 // a multiple of 4. With stereo_reuse the right eye's unclaimed pixels are gathered at the
-// full rate.
+// full rate. With spp > 1 a block gathers once per surface for each sample index.
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -64,6 +70,7 @@
 #include "core/ray_tracer.hpp"
 #include "techniques/photon_mapping/foveation.hpp"
 #include "techniques/photon_mapping/photon_gather.hpp"
+#include "techniques/photon_mapping/pixel_samples.hpp"
 #include "techniques/photon_mapping/stereo_reuse.hpp"
 #include "techniques/photon_mapping/tile_share.hpp"
 #include "core/traced_scene.hpp"
@@ -91,6 +98,7 @@ struct PhotonMappingSettings {
     int light_samples = 1;
     int max_photon_depth = 8;
     int tile_size = 16;
+    PixelSampling sampling;  // spp, jitter (pixel_samples.hpp)
     StereoReuseSettings stereo;
     FoveationSettings foveation;
 
@@ -118,8 +126,8 @@ private:
     void trace_and_build();
     void render_view(const EyeCamera& camera, const ViewOptions& options, Film& film, PhotonQueryStats& query_stats,
                      Stats& frame_stats) const;
-    void render_right_reusing(const EyeCamera& left, const EyeCamera& right, const KeptHits& kept, const Film& left_film,
-                              Film& film, PhotonQueryStats& query_stats, Stats& frame_stats) const;
+    void render_right_reusing(const EyeCamera& left, const EyeCamera& right, const KeptHits& kept, Film& film,
+                              PhotonQueryStats& query_stats, Stats& frame_stats) const;
 
     PhotonMappingSettings settings_;
     std::string config_hash_;

@@ -27,7 +27,7 @@ struct PrimaryHit {
     Vec3 geometric_normal{0};   // viewer side
     Vec3 emitted{0};            // emission towards the viewer (front faces only)
     Vec3 irradiance{0};         // Σ LightSampleRecord::weight: the Lambertian direct term / (ρ/π)
-    uint16_t sample_count = 0;  // records at samples[pixel · light_samples ...]
+    uint16_t sample_count = 0;  // records in the hit's light_samples-long span
     bool valid = false;
 };
 

@@ -45,7 +45,7 @@ std::optional<glm::ivec2> Reprojector::pixel(const Vec3& x) const {
     return eye_->pixel_from_ndc(Vec2(clip.x / clip.w, clip.y / clip.w));
 }
 
-StereoClaims::StereoClaims(const std::vector<PrimaryHit>& left_hits, const EyeCamera& left, const EyeCamera& right,
+StereoClaims::StereoClaims(std::span<const PrimaryHit> left_hits, const EyeCamera& left, const EyeCamera& right,
                            const RayTracer& tracer) {
     const size_t right_pixels = size_t(right.width()) * size_t(right.height());
     std::vector<std::atomic<uint64_t>> nearest(right_pixels);
@@ -141,7 +141,7 @@ bool same_surface_point(const PrimaryHit& left_hit, const PrimaryHit& right_hit,
     return glm::length(left_hit.point.position - right_hit.point.position) <= tolerance * footprint;
 }
 
-uint32_t crack_fill_source(const StereoClaims& claims, const std::vector<PrimaryHit>& left_hits,
+uint32_t crack_fill_source(const StereoClaims& claims, std::span<const PrimaryHit> left_hits,
                            const PrimaryHit& own_hit, const EyeCamera& right, int x, int y) {
     uint32_t best = StereoClaims::kNone;
     float best_distance = kInfinity;

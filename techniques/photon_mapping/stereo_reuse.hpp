@@ -26,6 +26,7 @@
 #include <atomic>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 #include "core/camera.hpp"
 #include "core/ray_tracer.hpp"
@@ -69,6 +70,11 @@ struct StereoClaimStats {
     uint64_t candidates = 0;       // hits that took part in a claim
     uint64_t claimed_pixels = 0;   // right pixels with at least one candidate
     uint64_t depth_conflicts = 0;  // claimed pixels whose candidates were on different surfaces
+
+    void merge(const StereoClaimStats& o) {
+        left_hits += o.left_hits, back_side += o.back_side, outside += o.outside, occluded += o.occluded;
+        candidates += o.candidates, claimed_pixels += o.claimed_pixels, depth_conflicts += o.depth_conflicts;
+    }
 };
 
 class StereoClaims {
@@ -76,7 +82,7 @@ public:
     static constexpr uint32_t kNone = 0xffffffffu;
 
     // Runs the claim pass over the left eye's hits (one per left pixel, row-major).
-    StereoClaims(const std::vector<PrimaryHit>& left_hits, const EyeCamera& left, const EyeCamera& right,
+    StereoClaims(std::span<const PrimaryHit> left_hits, const EyeCamera& left, const EyeCamera& right,
                  const RayTracer& tracer);
 
     // Left pixel whose hit claimed this right pixel, or kNone.
@@ -96,7 +102,7 @@ bool same_surface_point(const PrimaryHit& left_hit, const PrimaryHit& right_hit,
 // Crack filling: of the left hits claiming the 8 neighbours of right pixel (x, y), the one
 // nearest to the pixel's own hit among those on the same surface within
 // kCrackFillTolerance footprints (same_surface_point), or kNone.
-uint32_t crack_fill_source(const StereoClaims& claims, const std::vector<PrimaryHit>& left_hits,
+uint32_t crack_fill_source(const StereoClaims& claims, std::span<const PrimaryHit> left_hits,
                            const PrimaryHit& own_hit, const EyeCamera& right, int x, int y);
 
 }  // namespace gilab
