@@ -154,6 +154,18 @@ TEST_F(VctExperiments, SibenikStandsBesideSponzaAndTheWalkHasThePhotonCurve) {
         EXPECT_EQ(variants["sibenik"], expected);
     }
     EXPECT_EQ(variants.size(), sibenik ? 2u : 1u);
+    // Figs. 9 and 10 are plots in the paper: one curve per variant along each walk.
+    const ExperimentOutput fig10 = test::run_quick_experiment(vct_registry(), "vct-fig10");
+    for (const ExperimentOutput* out : {&fig9, &fig10}) {
+        EXPECT_EQ(out->plots.size(), variants.size());
+        for (const auto& [name, plot] : out->plots) {
+            ASSERT_EQ(plot.series.size(), 4u) << name;
+            for (const auto& series : plot.series) {
+                EXPECT_EQ(series.x.size(), fig9.tables.at(0).rows.size()) << name << " " << series.label;
+                EXPECT_EQ(variants.begin()->second.count(series.label), 1u) << series.label;
+            }
+        }
+    }
 }
 
 }  // namespace
