@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <optional>
@@ -443,6 +444,10 @@ public:
                                        " is not a non-negative integer");
             counts[k] = *c;
         }
+        // The edge count is not used, but CGAL doubles it in a 32-bit int (found by fuzzing).
+        if (counts[2] > uint64_t(INT32_MAX / 2))
+            throw Error(where, "malformed OFF: edge count " + std::to_string(counts[2]) + " is larger than " +
+                                   std::to_string(INT32_MAX / 2) + ", the most the OFF reader takes");
         vertices_ = counts[0];
         faces_ = counts[1];
         // The header counts need no check against the file's size here: the walk below

@@ -140,6 +140,7 @@ const BadCase kCases[] = {
     {"ply_version.ply", {":2:", "PLY version '2.0' is not supported"}},
     // Properties CGAL would cast to the wrong type (null pointers, found by fuzzing).
     {"off_counts_line_extra_numbers.off", {":2:", "'3' follows the vertex, face and edge counts"}},
+    {"off_huge_edge_count.off", {":2:", "edge count 2000000000 is larger than 1073741823"}},
     {"ply_integer_coordinate.ply", {"vertex property 'x' must be a float or double"}},
     {"ply_mixed_colour_types.ply", {"mixes uchar and other colour properties ('green'"}},
     {"ply_duplicate_property.ply", {"declares property 'x' twice"}},
