@@ -232,6 +232,10 @@ TEST(Cli, QuickCoreRaysWritesItsTables) {
     std::string text((std::istreambuf_iterator<char>(html)), std::istreambuf_iterator<char>());
     EXPECT_TRUE(contains(text, "core-rays"));
     EXPECT_TRUE(contains(text, "single_mrays_per_s"));
+    // Listed in the contents under the core measurements, its tables in scroll boxes.
+    EXPECT_TRUE(contains(text, "<h3>Core measurements</h3>\n<ul>\n<li><a href=\"#experiment-core-rays\">core-rays</a>"));
+    EXPECT_TRUE(contains(text, "<section class=\"result experiment\" id=\"experiment-core-rays\">"));
+    EXPECT_TRUE(contains(text, "<div class=\"table-scroll\"><table>"));
 }
 
 TEST(Cli, ReportWithoutResultsIsAnError) {
