@@ -114,6 +114,8 @@ int main(int argc, char** argv) {
     render->add_option("-W,--width", request.width, "image (per-eye) width in pixels");
     render->add_option("-H,--height", request.height, "image (per-eye) height in pixels");
     render->add_option("--spp", request.spp, "samples per pixel");
+    render->add_option("--time-budget", request.time_budget,
+                       "seconds: a progressive technique stops after the iteration that fills it");
     render->add_option("--seed", seed, "random seed")->capture_default_str();
     render->add_option("--time", request.time, "scene time in seconds (animated scenes)");
     render->add_option("-o,--output", request.output,

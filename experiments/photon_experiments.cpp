@@ -502,6 +502,8 @@ ExperimentOutput run_fig8(const ExperimentContext& ctx) {
 
 }  // namespace
 
+Experiment photon_convergence_experiment();  // pm-convergence, photon_convergence_experiment.cpp
+
 void register_photon_experiments(ExperimentRegistry& registry) {
     registry.add({"pm-table1", "P1",
                   "Table 1: photon-map structures (kd-tree, hash grid, nanoflann), kNN heap gather, Cornell box",
@@ -515,6 +517,7 @@ void register_photon_experiments(ExperimentRegistry& registry) {
                   run_table4});
     registry.add({"pm-fig8", "P1", "Fig. 8: images with a heap of 128 vs without heap, 512² photons, r = 0.08",
                   run_fig8});
+    registry.add(photon_convergence_experiment());
 }
 
 }  // namespace gilab

@@ -29,6 +29,7 @@ Settings read_settings(const RenderRequest& request) {
                                               : Settings(nlohmann::json::object(), "--set");
     for (const auto& a : request.assignments) settings.set_from_string(a);
     if (request.spp) settings.set("spp", *request.spp);
+    if (request.time_budget) settings.set("time_budget", *request.time_budget);
     settings.set("seed", request.seed);
     return settings;
 }
@@ -287,6 +288,9 @@ std::vector<std::string> run_render(const RenderRequest& request) {
     if (request.spp && !settings.was_read("spp"))
         throw Error("--spp", "technique '" + technique->name() +
                                  "' takes no pixel samples (it reads no setting 'spp'); leave --spp out");
+    if (request.time_budget && !settings.was_read("time_budget"))
+        throw Error("--time-budget", "technique '" + technique->name() +
+                                         "' takes no time budget (it reads no setting 'time_budget'); leave --time-budget out");
     settings.report_unused();
     if (plan) return render_sequence(*plan, *technique, *rig, opened, settings, request);
 

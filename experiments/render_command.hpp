@@ -16,6 +16,7 @@ struct RenderRequest {
     std::optional<float> ipd;
     std::optional<int> width, height; // default: preset's per-eye size, or 512×512 mono
     std::optional<int> spp;
+    std::optional<double> time_budget;  // seconds: the technique setting 'time_budget'
     uint64_t seed = 1;
     double time = 0;
     std::string output;               // path without extension; default results/render/SCENE_TECHNIQUE

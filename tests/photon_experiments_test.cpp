@@ -122,4 +122,41 @@ TEST_P(PhotonPaperColumns, EveryRowCarriesItsPublishedFigure) {
 INSTANTIATE_TEST_SUITE_P(Tables, PhotonPaperColumns,
                          testing::Values("pm-table1", "pm-table2", "pm-table3", "pm-table4"), test::test_name_of);
 
+TEST(PhotonConvergence, RunsQuickAndFillsItsColumns) {
+    // pm-convergence: every measured row has a positive time and error; per scene, each
+    // variant has its points, a row of times to reach the targets (a number or a
+    // string saying why there is none), and one curve in the scene's plot.
+    const ExperimentOutput out = test::run_quick_experiment(photon_registry(), "pm-convergence");
+    ASSERT_EQ(out.tables.size(), 2u);
+    std::map<std::string, std::map<std::string, int>> points;  // scene → variant → rows
+    for (const json& row : out.tables[0].rows) {
+        EXPECT_GT(row.at("wall ms").get<double>(), 0.0) << row.dump();
+        EXPECT_GT(row.at("relMSE").get<double>(), 0.0) << row.dump();
+        ++points[row.at("scene").get<std::string>()][row.at("variant").get<std::string>()];
+    }
+    ASSERT_TRUE(points.count("cornell"));
+    for (const auto& [scene, variants] : points) {
+        EXPECT_EQ(variants.size(), 3u) << scene;
+        for (const auto& [variant, count] : variants) EXPECT_GE(count, 2) << scene << " " << variant;
+    }
+    EXPECT_EQ(out.tables[1].rows.size(), 3 * points.size());
+    for (const json& row : out.tables[1].rows)
+        for (const std::string& column : out.tables[1].columns)
+            if (column.rfind("ms to", 0) == 0) {
+                const json& cell = row.at(column);
+                EXPECT_TRUE(cell.is_string() || (cell.is_number() && cell.get<double>() > 0)) << row.dump();
+            }
+    ASSERT_EQ(out.plots.size(), points.size());
+    for (const auto& [name, plot] : out.plots) {
+        EXPECT_TRUE(plot.log_x && plot.log_y) << name;
+        const std::string scene = name.substr(name.find('_') + 1);
+        ASSERT_TRUE(points.count(scene)) << name;
+        ASSERT_EQ(plot.series.size(), points.at(scene).size()) << name;
+        for (const PlotSeries& series : plot.series) {
+            ASSERT_TRUE(points.at(scene).count(series.label)) << name << ": " << series.label;
+            EXPECT_EQ(int(series.x.size()), points.at(scene).at(series.label)) << name << ": " << series.label;
+        }
+    }
+}
+
 }  // namespace

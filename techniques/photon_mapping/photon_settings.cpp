@@ -8,6 +8,55 @@ namespace gilab {
 
 const char* to_string(PhotonStorage storage) { return storage == PhotonStorage::EveryHit ? "every_hit" : "indirect"; }
 
+namespace {
+
+// Checks the progressive keys, and what progressive mode refuses (the strings are the
+// values as given, for the messages).
+void check_progressive(const Settings& s, PhotonMappingSettings& p, const std::string& pass, const std::string& map,
+                       const std::string& gather, const std::string& storage) {
+    const std::string& where = s.context();
+    ProgressiveSettings& g = p.progressive;
+    if (g.iterations < 1)
+        throw Error(where, "setting 'iterations' must be at least 1, got " + std::to_string(g.iterations));
+    if (!(g.alpha > 0.0 && g.alpha < 1.0))
+        throw Error(where, "setting 'alpha' must be in (0, 1) (the fraction of new photons kept), got " +
+                               format_number(g.alpha));
+    if (g.time_budget && !(*g.time_budget > 0.0))
+        throw Error(where, "setting 'time_budget' must be a positive number of seconds, got " +
+                               format_number(*g.time_budget));
+    if (!g.enabled) {
+        for (const char* key : {"iterations", "alpha", "time_budget"})
+            if (s.has(key))
+                throw Error(where, std::string("setting '") + key + "' needs progressive=true" +
+                                       (std::string(key) == "time_budget" ? " (gilab render --time-budget sets it)" : ""));
+        return;
+    }
+    const std::string needs = "setting 'progressive' ";
+    if (p.stereo.enabled)
+        throw Error(where, needs + "cannot be combined with 'stereo_reuse' (progressive mode keeps per-pixel statistics "
+                                   "for each eye; set stereo_reuse=false)");
+    if (p.foveation.enabled)
+        throw Error(where, needs + "cannot be combined with 'foveated' (every pixel keeps its own radius; set foveated=false)");
+    if (p.storage != PhotonStorage::Indirect)
+        throw Error(where, needs + "needs photon_storage=indirect (direct light by shadow rays, averaged over the "
+                                   "iterations), got photon_storage=" + storage);
+    if (p.gather != GatherMode::Radius)
+        throw Error(where, needs + "needs gather=radius (each pixel gathers within its own radius), got gather=" + gather);
+    if (p.photon_map != PhotonMapKind::HashGrid)
+        throw Error(where, needs + "needs photon_map=hash_grid (rebuilt every iteration), got photon_map=" + map);
+    if (p.split) throw Error(where, needs + "needs pass=fused, got pass=" + pass);
+    if (p.tile_shared != TileShare::Off)
+        throw Error(where, needs + "needs tile_shared=off (pixels gather within different radii)");
+    if (p.sampling.spp != 1)
+        throw Error(where, needs + "takes one visible point per pixel per iteration: leave 'spp' out (or 1) and raise "
+                                   "'iterations', got spp=" + std::to_string(p.sampling.spp));
+    if (s.has("jitter") && !p.sampling.jitter)
+        throw Error(where, needs + "jitters every iteration's visible point; leave 'jitter' out or set it true");
+    p.sampling.jitter = true;
+}
+
+}  // namespace
+
 PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     PhotonMappingSettings p;
     const std::string& where = s.context();
@@ -41,6 +90,11 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     p.foveation.periphery_photon_stride = s.get<int>("periphery_photon_stride", p.foveation.periphery_photon_stride);
     p.foveation.gaze_yaw_degrees = s.get<float>("gaze_yaw", p.foveation.gaze_yaw_degrees);
     p.foveation.gaze_pitch_degrees = s.get<float>("gaze_pitch", p.foveation.gaze_pitch_degrees);
+    p.progressive.enabled = s.get<bool>("progressive", p.progressive.enabled);
+    p.progressive.iterations = s.get<int>("iterations", p.progressive.iterations);
+    p.progressive.alpha = s.get<double>("alpha", p.progressive.alpha);
+    const double time_budget = s.get<double>("time_budget", 0.0);
+    if (s.has("time_budget")) p.progressive.time_budget = time_budget;
 
     if (photons < 1) throw Error(where, "setting 'photons' must be at least 1, got " + std::to_string(photons));
     p.photons = uint64_t(photons);
@@ -144,6 +198,7 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     if (p.stereo.fill && p.stereo.match != StereoMatch::Nearest) {
         throw Error(where, "setting 'stereo_fill' needs stereo_match=nearest (strict mode reuses only exact matches)");
     }
+    check_progressive(s, p, pass, map, gather, storage);
     return p;
 }
 

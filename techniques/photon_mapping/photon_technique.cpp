@@ -21,7 +21,9 @@ void PhotonMappingTechnique::prepare(const Scene& scene, const Settings& setting
     config_hash_ = settings.hash();
     scene_.load(scene);
     stats_ = Stats();
-    trace_and_build();
+    map_.reset();
+    // Progressive mode traces fresh photons every iteration of a render instead.
+    if (!settings_.progressive.enabled) trace_and_build();
     stats_.set("prepare_ms", watch.elapsed_ms());
     stats_.set("triangles", double(scene_.frame().triangle_count()));
     stats_.set("lights", double(scene_.lights().light_count()));
@@ -74,12 +76,14 @@ void PhotonMappingTechnique::update(double time) {
     if (!scene_.animated()) return;
     Stopwatch watch;
     scene_.set_time(time, &stats_);
-    trace_and_build();  // photons follow the moved geometry and lights
+    if (!settings_.progressive.enabled) trace_and_build();  // photons follow the moved geometry and lights
     stats_.set("update_ms", watch.elapsed_ms());
 }
 
 void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& films) {
-    if (!scene_.loaded() || !map_) throw Error("photon", "render() called before prepare()");
+    if (!scene_.loaded() || (!map_ && !settings_.progressive.enabled))
+        throw Error("photon", "render() called before prepare()");
+    if (settings_.progressive.enabled) return render_progressive(views, films);
     Stopwatch watch;
     films.assign(views.views.size(), Film());
     PhotonQueryStats queries;
@@ -147,7 +151,7 @@ void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& fil
 void register_photon_mapping(TechniqueRegistry& registry) {
     registry.add({"photon",
                   "photon mapping (P1): hash-grid / kd-tree / nanoflann photon map, radius or kNN gather, "
-                  "indirect or every-hit photon storage, fused or split passes, tile-shared gather",
+                  "indirect or every-hit photon storage, fused or split passes, tile-shared gather, progressive (SPPM)",
                   [] { return std::make_unique<PhotonMappingTechnique>(); }});
 }
 

@@ -60,6 +60,16 @@
 // pixel by shadow rays and shares only gathered indirect light) and a tile_size that is
 // a multiple of 4. With stereo_reuse the right eye's unclaimed pixels are gathered at the
 // full rate. With spp > 1 a block gathers once per surface for each sample index.
+//
+// Progressive mode (progressive.hpp; progressive_pass.cpp): progressive (false),
+// iterations (16), alpha (2/3), time_budget (seconds, optional); `radius` is the initial
+// radius. Each iteration takes one jittered visible point per pixel (drawn as sample
+// `iteration` of the pixel would be with spp samples) and a fresh photon pass (photon
+// pass index = iteration). Direct light is the shadow-ray estimate, so it needs
+// photon_storage=indirect, and it needs photon_map=hash_grid, gather=radius, pass=fused,
+// tile_shared=off, spp=1 (one visible point per iteration), and refuses stereo_reuse and
+// foveated. Stereo views render without reuse, each eye with its own statistics and
+// light-sample streams, sharing each iteration's photons.
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -71,6 +81,7 @@
 #include "techniques/photon_mapping/foveation.hpp"
 #include "techniques/photon_mapping/photon_gather.hpp"
 #include "techniques/photon_mapping/pixel_samples.hpp"
+#include "techniques/photon_mapping/progressive.hpp"
 #include "techniques/photon_mapping/stereo_reuse.hpp"
 #include "techniques/photon_mapping/tile_share.hpp"
 #include "core/traced_scene.hpp"
@@ -101,6 +112,7 @@ struct PhotonMappingSettings {
     PixelSampling sampling;  // spp, jitter (pixel_samples.hpp)
     StereoReuseSettings stereo;
     FoveationSettings foveation;
+    ProgressiveSettings progressive;  // progressive.hpp
 
     // Reads every key above (with get, so the caller can report the rest) and checks
     // the values; throws Error naming the bad key.
@@ -118,7 +130,7 @@ public:
     Stats stats() const override { return stats_; }
 
     const PhotonMappingSettings& settings() const { return settings_; }
-    const PhotonMap& photon_map() const { return *map_; }
+    const PhotonMap& photon_map() const { return *map_; }  // not in progressive mode (no map between renders)
 
 private:
     struct KeptHits;
@@ -128,6 +140,7 @@ private:
                      Stats& frame_stats) const;
     void render_right_reusing(const EyeCamera& left, const EyeCamera& right, const KeptHits& kept, Film& film,
                               PhotonQueryStats& query_stats, Stats& frame_stats) const;
+    void render_progressive(const ViewSet& views, std::vector<Film>& films);  // progressive_pass.cpp
 
     PhotonMappingSettings settings_;
     std::string config_hash_;
