@@ -79,6 +79,7 @@ LightSampler::LightSampler(const SceneFrame& frame, const std::vector<Material>&
         weights.push_back(power);
     }
     distribution_ = DiscreteDistribution(weights);
+    area_distribution_ = DiscreteDistribution(std::vector<float>(weights.begin(), weights.begin() + triangles_.size()));
 }
 
 LightSample LightSampler::sample_incident(const Vec3& x, Rng& rng) const {
@@ -88,26 +89,43 @@ LightSample LightSampler::sample_incident(const Vec3& x, Rng& rng) const {
     if (empty()) return s;
     size_t index = distribution_.sample(u_light);
     float pmf = distribution_.pmf(index);
-    if (index < triangles_.size()) {
-        const EmissiveTriangle& e = triangles_[index];
-        Vec2 b = sample_uniform_triangle(u);
-        Vec3 p = (1.0f - b.x - b.y) * e.p0 + b.x * e.p1 + b.y * e.p2;
-        Vec3 d = p - x;
-        float dist2 = glm::dot(d, d);
-        if (!(dist2 > 0.0f)) return s;
-        float dist = std::sqrt(dist2);
-        s.wi = d / dist;
-        s.distance = dist;
-        float cos_light = -glm::dot(e.normal, s.wi);
-        if (cos_light <= 0.0f) return s;  // back of a one-sided emitter
-        // Area pdf 1/A converted to solid angle at x.
-        s.pdf = pmf * dist2 / (cos_light * e.area);
-        s.Li = e.radiance;
-        return s;
-    }
-    const PunctualLight& l = punctual_[index - triangles_.size()];
+    if (index < triangles_.size()) return triangle_incident(triangles_[index], x, u, pmf);
+    s = punctual_incident(index - triangles_.size(), x);
+    s.pdf *= pmf;
+    return s;
+}
+
+LightSample LightSampler::sample_area_incident(const Vec3& x, Rng& rng) const {
+    float u_light = rng.uniform();
+    Vec2 u = rng.uniform2();
+    if (triangles_.empty()) return LightSample{};
+    size_t index = area_distribution_.sample(u_light);
+    return triangle_incident(triangles_[index], x, u, area_distribution_.pmf(index));
+}
+
+LightSample LightSampler::triangle_incident(const EmissiveTriangle& e, const Vec3& x, const Vec2& u, float pmf) {
+    LightSample s;
+    Vec2 b = sample_uniform_triangle(u);
+    Vec3 p = (1.0f - b.x - b.y) * e.p0 + b.x * e.p1 + b.y * e.p2;
+    Vec3 d = p - x;
+    float dist2 = glm::dot(d, d);
+    if (!(dist2 > 0.0f)) return s;
+    float dist = std::sqrt(dist2);
+    s.wi = d / dist;
+    s.distance = dist;
+    float cos_light = -glm::dot(e.normal, s.wi);
+    if (cos_light <= 0.0f) return s;  // back of a one-sided emitter
+    // Area pdf 1/A converted to solid angle at x.
+    s.pdf = pmf * dist2 / (cos_light * e.area);
+    s.Li = e.radiance;
+    return s;
+}
+
+LightSample LightSampler::punctual_incident(size_t i, const Vec3& x) const {
+    const PunctualLight& l = punctual_.at(i);
+    LightSample s;
     s.delta = true;
-    s.pdf = pmf;
+    s.pdf = 1.0f;
     if (l.type == LightType::Directional) {
         s.wi = -l.direction;
         s.distance = kInfinity;

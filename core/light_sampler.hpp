@@ -48,6 +48,15 @@ public:
 
     // Next-event estimation: pick a light by power, sample a point on it.
     LightSample sample_incident(const Vec3& shading_point, Rng& rng) const;
+    // The same among the emissive triangles only (pdf: their own power distribution),
+    // for estimators that take every punctual light exactly (punctual_incident). With
+    // no punctual light it draws the same samples as sample_incident.
+    LightSample sample_area_incident(const Vec3& shading_point, Rng& rng) const;
+    bool has_area_lights() const { return !triangles_.empty(); }
+    // Punctual light i (0 ≤ i < punctual_count) seen from a point, with pdf 1 (0 at the
+    // light's own position).
+    size_t punctual_count() const { return punctual_.size(); }
+    LightSample punctual_incident(size_t i, const Vec3& shading_point) const;
     // Solid-angle pdf that sample_incident would produce direction wi hitting emissive
     // triangle (mesh, triangle) at point p_light (for MIS on BSDF-sampled hits).
     float pdf_incident(const Vec3& shading_point, uint32_t mesh, uint32_t triangle,
@@ -60,7 +69,10 @@ public:
 private:
     std::vector<EmissiveTriangle> triangles_;
     std::vector<PunctualLight> punctual_;
+    static LightSample triangle_incident(const EmissiveTriangle& e, const Vec3& x, const Vec2& u, float pmf);
+
     DiscreteDistribution distribution_;   // over triangles_ then punctual_
+    DiscreteDistribution area_distribution_;  // over triangles_
     std::vector<int> triangle_index_of_;  // per (mesh, triangle) lookup, flattened
     std::vector<size_t> mesh_offsets_;
     Vec3 scene_center_{0};

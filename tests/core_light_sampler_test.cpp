@@ -156,6 +156,56 @@ TEST(LightSampler, PunctualLights) {
     EXPECT_NEAR(glm::length(s.wi - glm::normalize(Vec3(-1, 2, 0))), 0.0f, 1e-5f);
 }
 
+TEST(LightSampler, AreaSamplingAndExactPunctualLights) {
+    // Area lights alone: sample_area_incident draws exactly what sample_incident draws.
+    const std::vector<Material> mats = test_materials();
+    const LightSampler area_only(area_frame(), mats);
+    ASSERT_TRUE(area_only.has_area_lights());
+    EXPECT_EQ(area_only.punctual_count(), 0u);
+    for (uint64_t k = 0; k < 64; ++k) {
+        Rng a(9, k), b(9, k);
+        const LightSample x = area_only.sample_incident(Vec3(0.2f, 0, 0.1f), a);
+        const LightSample y = area_only.sample_area_incident(Vec3(0.2f, 0, 0.1f), b);
+        EXPECT_EQ(x.wi, y.wi);
+        EXPECT_EQ(x.pdf, y.pdf);
+        EXPECT_EQ(x.Li, y.Li);
+    }
+    // With a point light beside them, the area samples' pdf leaves the point's power out,
+    // and punctual_incident gives the point with pdf 1; sample_incident's point samples
+    // carry the point's selection probability.
+    SceneFrame frame = area_frame();
+    PunctualLight point;
+    point.type = LightType::Point;
+    point.position = Vec3(0, 3, 0);
+    point.intensity = Vec3(100.0f);
+    frame.lights.push_back(point);
+    const LightSampler mixed(frame, mats);
+    ASSERT_EQ(mixed.punctual_count(), 1u);
+    const LightSample p = mixed.punctual_incident(0, Vec3(0, 1, 0));
+    EXPECT_TRUE(p.delta);
+    EXPECT_EQ(p.pdf, 1.0f);
+    EXPECT_NEAR(p.Li.x, 100.0f / 4.0f, 1e-4f);
+    EXPECT_NEAR(glm::length(p.wi - Vec3(0, 1, 0)), 0.0f, 1e-6f);
+    bool saw_point = false;
+    for (uint64_t k = 0; k < 256; ++k) {
+        Rng a(3, k), b(3, k);
+        const LightSample area = mixed.sample_area_incident(Vec3(0.2f, 0, 0.1f), a);
+        EXPECT_FALSE(area.delta);
+        if (area.pdf > 0) {
+            Rng c(3, k);
+            const LightSample alone = area_only.sample_area_incident(Vec3(0.2f, 0, 0.1f), c);
+            EXPECT_EQ(area.pdf, alone.pdf);
+        }
+        const LightSample any = mixed.sample_incident(Vec3(0.2f, 0, 0.1f), b);
+        if (any.delta) {
+            saw_point = true;
+            EXPECT_GT(any.pdf, 0.5f);
+            EXPECT_LT(any.pdf, 1.0f);
+        }
+    }
+    EXPECT_TRUE(saw_point);
+}
+
 TEST(LightSampler, SpotFalloffIsSmoothBetweenTheCones) {
     SceneFrame frame;
     add_triangle(frame, {-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, 0);

@@ -133,7 +133,7 @@ ExpectedImage expected_image(const Scene& scene, const EyeCamera& camera, const 
                 const SurfaceInteraction si = make_interaction(frame, ray, hit);
                 const Material& m = scene.materials[si.material];
                 PrimaryHit ph = primary_hit_of(si, m);
-                std::vector<LightSampleRecord> samples(size_t(s.light_samples));
+                std::vector<LightSampleRecord> samples(shading.records_per_hit());
                 sample_direct_light(shading, si, rng, samples, ph);
                 direct += DVec3(direct_radiance(m, ph, si.wo, samples));
                 GatherScratch scratch;

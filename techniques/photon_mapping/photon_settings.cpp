@@ -62,6 +62,7 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
     const std::string& where = s.context();
     int64_t photons = s.get<int64_t>("photons", int64_t(p.photons));
     p.radius = s.get<float>("radius", p.radius);
+    p.radius_from_scene = !s.has("radius");
     std::string gather = s.get<std::string>("gather", "radius");
     p.k = s.get<int>("k", p.k);
     std::string map = s.get<std::string>("photon_map", to_string(p.photon_map));

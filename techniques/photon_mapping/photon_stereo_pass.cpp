@@ -46,7 +46,7 @@ void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const E
     parallel_for_tiles(width, right.height(), s.tile_size, [&](const Tile& tile) {
         GatherScratch scratch;
         PhotonQueryStats qs;
-        std::vector<LightSampleRecord> samples(size_t(std::max(s.light_samples, 0)));
+        std::vector<LightSampleRecord> samples(shading.records_per_hit());
         std::vector<Vec3> sample_direct(static_cast<size_t>(spp)), sample_indirect(static_cast<size_t>(spp));
         uint64_t n_reused = 0, n_glossy = 0, n_rejected = 0, n_shaded = 0, n_filled = 0;
         for (int y = tile.y0; y < tile.y1; ++y)

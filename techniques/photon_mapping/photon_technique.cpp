@@ -1,6 +1,7 @@
 #include "techniques/photon_mapping/photon_technique.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include "core/error.hpp"
 #include "core/format.hpp"
 #include "techniques/photon_mapping/photon_passes.hpp"
@@ -21,6 +22,11 @@ void PhotonMappingTechnique::prepare(const Scene& scene, const Settings& setting
     config_hash_ = settings.hash();
     scene_.load(scene);
     stats_ = Stats();
+    const Bounds3& bounds = scene_.frame().bounds;
+    const float diagonal = bounds.empty() ? 0.0f : glm::length(bounds.max - bounds.min);
+    if (settings_.radius_from_scene && diagonal > 0.0f && std::isfinite(diagonal))
+        settings_.radius = PhotonMappingSettings::kRadiusPerDiagonal * diagonal;
+    stats_.set("radius", double(settings_.radius));
     map_.reset();
     // Progressive mode traces fresh photons every iteration of a render instead.
     if (!settings_.progressive.enabled) trace_and_build();

@@ -4,8 +4,8 @@
 // over the photon map at the primary hit (photon_gather.hpp). Where direct light comes
 // from depends on `photon_storage`:
 // * indirect (default): the map stores photons from their second surface hit on, and
-//   direct light is computed by shadow rays (next-event estimation, `light_samples` per
-//   hit). Layers: direct = emission seen directly + one-bounce lighting by shadow rays;
+//   direct light is computed by shadow rays (next-event estimation: each punctual light
+//   exactly and `light_samples` area-light samples per hit, primary_hit.hpp). Layers: direct = emission seen directly + one-bounce lighting by shadow rays;
 //   indirect = the map's estimate (light that has bounced at least once).
 // * every_hit (P1's photon map): a copy is stored at every non-specular hit, the first
 //   one included, so the map holds one more photon for every photon that reaches a
@@ -15,7 +15,8 @@
 //   indirect = the later-hit photons' estimate, the same quantity as in indirect mode.
 // Either way color = direct + indirect, the same split as the path tracer's layers.
 //
-// Settings: photons (emitted, 256·256), radius (0.05), gather (radius | knn), k (128),
+// Settings: photons (emitted, 256·256), radius (3 % of the scene's bounding-box
+// diagonal), gather (radius | knn), k (128),
 // photon_map (hash_grid | kd_tree | nanoflann), hash_query (runs9 | cells27),
 // photon_storage (indirect | every_hit), pass (fused: trace and gather per pixel in one
 // loop | split: all primary hits into a buffer first, then a gather pass; bit-identical),
@@ -95,7 +96,12 @@ const char* to_string(PhotonStorage storage);  // "indirect", "every_hit"
 
 struct PhotonMappingSettings {
     uint64_t photons = 256 * 256;
+    // Without a `radius` setting, prepare() sets it to this fraction of the scene's
+    // bounding-box diagonal (0.052 on the unit Cornell box), so that the default gathers
+    // a similar share of the photons on a 1 m box and a 40 m cathedral.
+    static constexpr float kRadiusPerDiagonal = 0.03f;
     float radius = 0.05f;
+    bool radius_from_scene = true;  // no `radius` setting given
     GatherMode gather = GatherMode::Radius;
     int k = 128;
     PhotonMapKind photon_map = PhotonMapKind::HashGrid;

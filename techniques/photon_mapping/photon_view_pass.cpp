@@ -44,7 +44,7 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
     if (periphery_map_) periphery.emplace(*periphery_map_, scene_.materials(), s.gather, s.radius, size_t(s.k));
     const PrimaryShadingContext shading{scene_.tracer(), scene_.frame(), scene_.materials(), scene_.lights(),
                                         s.light_samples};
-    const size_t light_samples = size_t(std::max(s.light_samples, 0));
+    const size_t light_samples = shading.records_per_hit();
     float* direct = film.layer("direct").data.data();
     float* indirect = film.layer("indirect").data.data();
     std::mutex merge;

@@ -19,16 +19,22 @@ void sample_direct_light(const PrimaryShadingContext& ctx, const SurfaceInteract
     // A black surface reflects nothing whatever the samples say: skip its shadow rays.
     const bool reflects = max_component(m.albedo) > 0.0f || m.has_glossy_lobe();
     if (ctx.light_samples <= 0 || ctx.lights.empty() || !reflects) return;
-    const float inv_n = 1.0f / float(ctx.light_samples);
-    for (int k = 0; k < ctx.light_samples; ++k) {
-        LightSample ls = ctx.lights.sample_incident(si.position, rng);
-        if (!(ls.pdf > 0.0f) || is_black(ls.Li) || glm::dot(ls.wi, si.geometric_normal) <= 0.0f) continue;
+    auto add = [&](const LightSample& ls, float inv_n) {
+        if (!(ls.pdf > 0.0f) || is_black(ls.Li) || glm::dot(ls.wi, si.geometric_normal) <= 0.0f) return;
         const float cos_i = glm::dot(si.shading_normal, ls.wi);
-        if (!(cos_i > 0.0f) || ctx.tracer.occluded(shadow_ray(si, ls))) continue;
+        if (!(cos_i > 0.0f) || ctx.tracer.occluded(shadow_ray(si, ls))) return;
         LightSampleRecord rec{ls.wi, ls.Li * (cos_i / ls.pdf * inv_n)};
         hit.irradiance += rec.weight;
-        if (hit.sample_count < samples.size()) samples[hit.sample_count++] = rec;
+        if (hit.sample_count < samples.size() && hit.sample_count < UINT16_MAX) samples[hit.sample_count++] = rec;
+    };
+    const float inv_n = 1.0f / float(ctx.light_samples);
+    if (!ctx.exact_punctual()) {
+        for (int k = 0; k < ctx.light_samples; ++k) add(ctx.lights.sample_incident(si.position, rng), inv_n);
+        return;
     }
+    for (size_t i = 0; i < ctx.lights.punctual_count(); ++i) add(ctx.lights.punctual_incident(i, si.position), 1.0f);
+    if (ctx.lights.has_area_lights())
+        for (int k = 0; k < ctx.light_samples; ++k) add(ctx.lights.sample_area_incident(si.position, rng), inv_n);
 }
 
 Vec3 direct_radiance(const Material& m, const PrimaryHit& hit, const Vec3& wo, std::span<const LightSampleRecord> samples) {

@@ -31,6 +31,12 @@ struct PrimaryHit {
     bool valid = false;
 };
 
+// Up to this many punctual lights are each taken exactly, one shadow ray apiece, and
+// `light_samples` samples go to the emissive triangles alone: sampling a few point lights
+// and a sun by power leaves rare, bright pixels where a weak light is picked. With more
+// punctual lights every light is sampled by power.
+inline constexpr size_t kExactPunctualLights = 16;
+
 // Everything a view's hits are shaded with.
 struct PrimaryShadingContext {
     const RayTracer& tracer;
@@ -38,13 +44,22 @@ struct PrimaryShadingContext {
     const std::vector<Material>& materials;
     const LightSampler& lights;
     int light_samples = 1;
+
+    bool exact_punctual() const { return lights.punctual_count() <= kExactPunctualLights; }
+    // The records one hit's next-event estimation can keep (its span's size).
+    size_t records_per_hit() const {
+        if (light_samples <= 0) return 0;
+        return size_t(light_samples) + (exact_punctual() ? lights.punctual_count() : 0);
+    }
 };
 
 // The geometry of a hit and the emission the viewer sees; no lighting yet.
 PrimaryHit primary_hit_of(const SurfaceInteraction& si, const Material& m);
 
-// Next-event estimation at the hit: light samples drawn from `rng`, the unoccluded ones
-// summed into hit.irradiance and stored in `samples` (size light_samples).
+// Next-event estimation at the hit: every punctual light exactly and light_samples area
+// samples drawn from `rng` (or, past kExactPunctualLights, light_samples samples of all
+// lights by power); the unoccluded ones summed into hit.irradiance and stored in
+// `samples` (size ctx.records_per_hit()).
 void sample_direct_light(const PrimaryShadingContext& ctx, const SurfaceInteraction& si, Rng& rng,
                          std::span<LightSampleRecord> samples, PrimaryHit& hit);
 

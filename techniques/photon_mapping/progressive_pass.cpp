@@ -69,7 +69,6 @@ void PhotonMappingTechnique::render_progressive(const ViewSet& views, std::vecto
     const PhotonMappingSettings& s = settings_;
     const ProgressiveSettings& g = s.progressive;
     Stopwatch watch;
-    const size_t light_samples = size_t(std::max(s.light_samples, 0));
     std::vector<ProgressiveView> state(views.views.size());
     for (size_t v = 0; v < views.views.size(); ++v) {
         const EyeCamera& camera = views.views[v];
@@ -98,7 +97,7 @@ void PhotonMappingTechnique::render_progressive(const ViewSet& views, std::vecto
             const EyeCamera& camera = views.views[v];
             ProgressiveView& view = state[v];
             parallel_for_tiles(camera.width(), camera.height(), s.tile_size, [&](const Tile& tile) {
-                std::vector<LightSampleRecord> samples(light_samples);
+                std::vector<LightSampleRecord> samples(shading.records_per_hit());
                 for (int y = tile.y0; y < tile.y1; ++y)
                     for (int x = tile.x0; x < tile.x1; ++x) {
                         const uint32_t pixel = uint32_t(size_t(y) * size_t(camera.width()) + size_t(x));
