@@ -3,6 +3,8 @@
 // sees the same voxels, the split build gives the same DAG as the whole conversion,
 // the three traversals agree).
 #include <gtest/gtest.h>
+
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -172,7 +174,9 @@ TEST_F(DagExperimentsTest, Table3TimesArePositiveAndSplitMatchesWhole) {
 TEST_F(DagExperimentsTest, Fig13TraversalsAgree) {
     fs::path dir;
     ExperimentOutput out = run_quick("dag-fig13", &dir);
-    EXPECT_EQ(out.files.size(), out.tables[0].rows.size());  // one depth image per scene
+    const auto depth_images = std::count_if(out.files.begin(), out.files.end(),
+                                            [](const std::string& f) { return f.rfind("depth_", 0) == 0; });
+    EXPECT_EQ(size_t(depth_images), out.tables[0].rows.size());  // one depth image per scene
     EXPECT_TRUE(fs::exists(dir / "depth_bunny.png"));
     for (const json& row : out.tables[0].rows) {
         EXPECT_TRUE(row["same_hits_in_all_three"].get<bool>());
@@ -185,6 +189,22 @@ TEST_F(DagExperimentsTest, Fig13TraversalsAgree) {
         for (const char* c : {"svo_mrays_per_s", "esvo_mrays_per_s", "svdag_mrays_per_s"}) EXPECT_GT(num(row, c), 0);
         EXPECT_NEAR(num(row, "svdag_over_svo_throughput"), num(row, "svdag_mrays_per_s") / num(row, "svo_mrays_per_s"),
                     1e-9);
+    }
+    // The paper's plot: ten single rays per scene, each a hit, timed for each structure,
+    // drawn as one SVG per scene with a curve per structure.
+    ASSERT_EQ(out.tables.size(), 2u);
+    const ResultTable& single = out.tables[1];
+    EXPECT_EQ(single.rows.size(), 10 * out.tables[0].rows.size());
+    for (const json& row : single.rows) {
+        EXPECT_GT(num(row, "nodes_visited"), 1);
+        for (const char* c : {"svo_us", "esvo_us", "svdag_us"}) EXPECT_GT(num(row, c), 0) << row.dump();
+    }
+    ASSERT_EQ(out.plots.size(), out.tables[0].rows.size());
+    for (const auto& [name, plot] : out.plots) {
+        EXPECT_EQ(name.rfind("fig13_", 0), 0u) << name;
+        ASSERT_EQ(plot.series.size(), 3u);
+        for (const PlotSeries& series : plot.series) EXPECT_EQ(series.x.size(), 10u) << name << " " << series.label;
+        EXPECT_TRUE(fs::exists(dir / (name + ".svg"))) << name;
     }
 }
 
