@@ -1,6 +1,7 @@
 #include "core/asset_paths.hpp"
 
 #include <cstdlib>
+#include <filesystem>
 #include "core/error.hpp"
 
 namespace gilab {
@@ -61,6 +62,30 @@ std::string AssetPaths::describe() const {
         s += dir.string();
     }
     return s;
+}
+
+std::vector<std::string> AssetPaths::missing_directories(const std::string& list) {
+    std::vector<std::string> missing;
+    size_t start = 0;
+    while (start <= list.size()) {
+        size_t end = list.find(':', start);
+        if (end == std::string::npos) end = list.size();
+        if (end > start) {
+            std::string dir = list.substr(start, end - start);
+            std::error_code ec;
+            if (!std::filesystem::is_directory(dir, ec)) missing.push_back(std::move(dir));
+        }
+        start = end + 1;
+    }
+    return missing;
+}
+
+void AssetPaths::require_directories(const std::string& list, const std::string& context) {
+    const std::vector<std::string> missing = missing_directories(list);
+    if (missing.empty()) return;
+    std::error_code ec;
+    throw Error(context, "'" + missing.front() + "' is not a directory" +
+                             (std::filesystem::exists(missing.front(), ec) ? "" : " (it does not exist)"));
 }
 
 }  // namespace gilab

@@ -23,6 +23,13 @@ public:
     const std::vector<std::filesystem::path>& dirs() const { return dirs_; }
     std::string describe() const;  // "dir1:dir2"
 
+    // Throws Error(context, …) naming the first entry of a colon-separated directory list
+    // that is not a directory (a typo in --assets is an error, not a silent fall-back to
+    // other copies of the files).
+    static void require_directories(const std::string& list, const std::string& context);
+    // The entries of a colon-separated list that are not directories (empty ones skipped).
+    static std::vector<std::string> missing_directories(const std::string& list);
+
 private:
     std::vector<std::filesystem::path> dirs_;
 };

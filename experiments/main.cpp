@@ -48,27 +48,10 @@ void print_list(const std::string& what) {
 // the same files); missing $GILAB_ASSETS directories only get a note, since the
 // environment is often shared between machines.
 void check_asset_directories(const std::string& flag) {
-    auto each = [](const std::string& list, auto&& f) {
-        size_t start = 0;
-        while (start <= list.size()) {
-            size_t end = list.find(':', start);
-            if (end == std::string::npos) end = list.size();
-            if (end > start) f(list.substr(start, end - start));
-            start = end + 1;
-        }
-    };
-    each(flag, [](const std::string& dir) {
-        std::error_code ec;
-        if (!std::filesystem::is_directory(dir, ec))
-            throw Error("--assets", "'" + dir + "' is not a directory" +
-                                        (std::filesystem::exists(dir, ec) ? "" : " (it does not exist)"));
-    });
+    AssetPaths::require_directories(flag, "--assets");
     if (const char* env = std::getenv("GILAB_ASSETS"))
-        each(env, [](const std::string& dir) {
-            std::error_code ec;
-            if (!std::filesystem::is_directory(dir, ec))
-                std::cerr << "gilab: note: $GILAB_ASSETS: '" << dir << "' is not a directory; ignored\n";
-        });
+        for (const std::string& dir : AssetPaths::missing_directories(env))
+            std::cerr << "gilab: note: $GILAB_ASSETS: '" << dir << "' is not a directory; ignored\n";
 }
 
 constexpr int kMaxThreads = 1024;

@@ -248,24 +248,19 @@ HeadPose pose_from_camera(const SceneCamera& c) {
     return {eye.position(), eye.orientation()};
 }
 
-std::vector<std::string> run_render(const RenderRequest& request) {
+RenderSetup begin_render(const RenderRequest& request) {
     check_options(request);
-    const TechniqueRegistry& registry = TechniqueRegistry::builtin();
-    std::unique_ptr<Technique> technique = registry.create(request.technique);  // fail fast on a bad name
-    Settings settings = read_settings(request);
-
-    ViewSet views;
-    std::optional<HmdRig> rig;
-    if (request.hmd) rig = HmdRig(find_hmd_preset(*request.hmd));  // before loading: bad preset fails fast
+    RenderSetup setup;
+    setup.technique = TechniqueRegistry::builtin().create(request.technique);  // fail fast on a bad name
+    setup.settings = read_settings(request);
+    if (request.hmd) setup.rig = HmdRig(find_hmd_preset(*request.hmd));  // before loading: bad preset fails fast
     if (request.width && request.height) check_resolution(*request.width, *request.height);
     else if (request.width || request.height) throw Error("--width/--height", "give both or neither");
-    std::optional<TracePlan> plan = plan_trace(request);  // a bad trace fails before the scene loads
+    return setup;
+}
 
-    OpenedScene opened = open_scene(request.scene, request.assets);
-    for (const auto& w : opened.warnings) std::cerr << "gilab: note: " << request.scene << ": " << w << "\n";
-    const Scene& scene = opened.scene;
-
-    if (rig) {
+ViewSet aim_views(RenderSetup& setup, const RenderRequest& request, const Scene& scene) {
+    if (std::optional<HmdRig>& rig = setup.rig) {
         if (scene.hmd) rig->set_pose(scene.hmd->pose);
         else rig->set_pose(pose_from_camera(*scene.camera));
         if (scene.hmd && scene.hmd->ipd) rig->set_ipd(*scene.hmd->ipd);
@@ -273,33 +268,56 @@ std::vector<std::string> run_render(const RenderRequest& request) {
         if (request.width) rig->set_resolution(*request.width, *request.height);
         check_resolution(rig->preset().width, rig->preset().height);
         check_film_memory(rig->preset().width, rig->preset().height, 2);
-        views = ViewSet::stereo_pair(rig->eye(Eye::Left), rig->eye(Eye::Right));
-    } else {
-        int w = request.width.value_or(512), h = request.height.value_or(512);
-        check_resolution(w, h);
-        check_film_memory(w, h, 1);
-        const SceneCamera& c = *scene.camera;
-        views = ViewSet::mono(EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, w, h));
+        return ViewSet::stereo_pair(rig->eye(Eye::Left), rig->eye(Eye::Right));
     }
+    int w = request.width.value_or(512), h = request.height.value_or(512);
+    check_resolution(w, h);
+    check_film_memory(w, h, 1);
+    const SceneCamera& c = *scene.camera;
+    return ViewSet::mono(EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, w, h));
+}
 
-    technique->prepare(scene, settings);
+void prepare_render(RenderSetup& setup, const RenderRequest& request, const Scene& scene) {
+    Technique& technique = *setup.technique;
+    const Settings& settings = setup.settings;
+    technique.prepare(scene, settings);
     // --spp is stored as the setting 'spp'; a technique that never asks for it takes no
     // pixel samples, which is the option's fault, not an unknown --set key.
     if (request.spp && !settings.was_read("spp"))
-        throw Error("--spp", "technique '" + technique->name() +
+        throw Error("--spp", "technique '" + technique.name() +
                                  "' takes no pixel samples (it reads no setting 'spp'); leave --spp out");
     if (request.time_budget && !settings.was_read("time_budget"))
-        throw Error("--time-budget", "technique '" + technique->name() +
+        throw Error("--time-budget", "technique '" + technique.name() +
                                          "' takes no time budget (it reads no setting 'time_budget'); leave --time-budget out");
     settings.report_unused();
-    if (plan) return render_sequence(*plan, *technique, *rig, opened, settings, request);
+}
 
-    if (request.time != 0) technique->update(request.time);
+std::vector<Film> render_films(RenderSetup& setup, const RenderRequest& request, const Scene& scene,
+                               const ViewSet& views) {
+    Technique& technique = *setup.technique;
+    if (request.time != 0) technique.update(request.time);
     std::vector<Film> films(views.views.size());
-    technique->render(views, films);
-
+    technique.render(views, films);
     for (size_t i = 0; i < films.size(); ++i)
-        tag_film(films[i], scene, views.names[i], *technique, settings, request, rig ? &*rig : nullptr);
+        tag_film(films[i], scene, views.names[i], technique, setup.settings, request, setup.rig ? &*setup.rig : nullptr);
+    return films;
+}
+
+std::vector<std::string> run_render(const RenderRequest& request) {
+    RenderSetup setup = begin_render(request);
+    std::optional<TracePlan> plan = plan_trace(request);  // a bad trace fails before the scene loads
+
+    OpenedScene opened = open_scene(request.scene, request.assets);
+    for (const auto& w : opened.warnings) std::cerr << "gilab: note: " << request.scene << ": " << w << "\n";
+    const Scene& scene = opened.scene;
+
+    const ViewSet views = aim_views(setup, request, scene);
+    prepare_render(setup, request, scene);
+    if (plan) return render_sequence(*plan, *setup.technique, *setup.rig, opened, setup.settings, request);
+
+    std::vector<Film> films = render_films(setup, request, scene, views);
+    Technique* technique = setup.technique.get();
+    const std::optional<HmdRig>& rig = setup.rig;
 
     warn_if_unseen(opened, films);
     std::string base = request.output;

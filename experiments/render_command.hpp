@@ -6,6 +6,8 @@
 #include "core/asset_paths.hpp"
 #include "core/hmd.hpp"
 #include "core/scene.hpp"
+#include "core/settings.hpp"
+#include "techniques/technique.hpp"
 
 namespace gilab {
 
@@ -31,6 +33,27 @@ struct RenderRequest {
     std::optional<float> trace_scale;  // scene units per trace metre; default 1
     AssetPaths assets;
 };
+
+// The steps of `gilab render` that make the images, in order. The Python module runs the
+// same steps, so both give bit-identical images for the same request.
+struct RenderSetup {
+    std::unique_ptr<Technique> technique;
+    Settings settings;
+    std::optional<HmdRig> rig;  // set: a stereo pair
+};
+// Checks the options and creates the technique, its settings and the HMD rig, all before
+// the scene loads, so a bad option never costs a scene load.
+RenderSetup begin_render(const RenderRequest& request);
+// The views of the scene: the rig's pair (posed by the scene's HMD or its camera, with
+// the request's ipd and size) or the scene camera at the request's size (512² default).
+ViewSet aim_views(RenderSetup& setup, const RenderRequest& request, const Scene& scene);
+// Prepares the technique for the scene; settings it never read are errors (and --spp or
+// --time-budget given to a technique that takes none).
+void prepare_render(RenderSetup& setup, const RenderRequest& request, const Scene& scene);
+// Moves the scene to request.time when it is not 0, renders every view and tags each film
+// with its provenance (scene, view, technique, settings, seed, HMD).
+std::vector<Film> render_films(RenderSetup& setup, const RenderRequest& request, const Scene& scene,
+                               const ViewSet& views);
 
 // Renders and writes OUTPUT.exr and OUTPUT.png; returns the paths written. With a head
 // trace: OUTPUT_0000.exr/.png per frame and OUTPUT_frames.csv (head pose, render time).

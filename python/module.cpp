@@ -1,0 +1,48 @@
+// The `gilab` Python module: bindings over the C++ libraries, one file per concept.
+#include "core/error.hpp"
+#include "python/bindings.hpp"
+
+namespace gilab::python {
+
+// gilab::Error is bad input (a missing file, a malformed mesh, an unknown setting, a
+// wrong array shape), so in Python it is a ValueError carrying the C++ message.
+void register_errors(py::module_& m) {
+    py::register_exception<Error>(m, "Error", PyExc_ValueError).doc() =
+        "Bad input: the message names where the problem is (file, file:line, setting or argument) and what is wrong.";
+}
+
+}  // namespace gilab::python
+
+PYBIND11_MODULE(gilab, m) {
+    using namespace gilab::python;
+    m.doc() = R"doc(gilab — a global-illumination research framework (photon mapping for HMDs,
+sparse voxel DAGs, cascaded voxel cone tracing, a reference path tracer).
+
+These bindings wrap the C++ code; they compute nothing of their own:
+
+  load_scene, Scene, SceneFrame        scenes as `gilab render` opens them
+  Camera, HmdRig, hmd, HeadPose        cameras and the HMD stereo rig
+  render, RenderResult, Film           renders (bit-identical to `gilab render`)
+  read_exr                             EXR files written by gilab
+  experiments, run_experiment          the experiment runner
+  voxelize, VoxelList, Svo, Esvo, Svdag   sparse voxel structures
+  PhotonMap                            photon maps with radius / kNN queries
+  relative_mse, ssim, flip             image metrics on NumPy arrays
+  techniques, scenes, hmd_presets      what is available (as `gilab list`)
+  set_memory_limit                     the memory budget (as --memory-limit)
+
+Bad input raises gilab.Error (a ValueError) with the C++ message. Long calls
+(renders, builds, experiments) release the GIL.
+)doc";
+    register_errors(m);
+    register_film_bindings(m);
+    register_camera_bindings(m);
+    register_scene_bindings(m);
+    register_render_bindings(m);
+    register_experiment_bindings(m);
+    register_voxel_bindings(m);
+    register_octree_bindings(m);
+    register_photon_map_bindings(m);
+    register_metric_bindings(m);
+    register_catalogue_bindings(m);
+}

@@ -1,0 +1,38 @@
+"""gilab.experiments / gilab.run_experiment against `gilab experiment` for the same run."""
+import json
+
+import pytest
+
+import gilab
+
+
+def test_experiment_list_matches_the_cli(run_cli):
+    listed = run_cli("experiment", "list").stdout
+    names = [line.split()[0] for line in listed.splitlines()[1:] if line.startswith("  ")]
+    assert [e["name"] for e in gilab.experiments()] == names
+    assert all(e["paper"] and e["description"] for e in gilab.experiments())
+
+
+def test_run_experiment_returns_the_cli_tables(tmp_path, run_cli):
+    # vct-table1 counts voxels: deterministic, so both runs must agree exactly.
+    run_cli("experiment", "vct-table1", "--quick", "--results", tmp_path / "cli")
+    written = json.loads((tmp_path / "cli" / "vct-table1" / "results.json").read_text())
+    result = gilab.run_experiment("vct-table1", quick=True, results=tmp_path / "py", threads=2)
+    assert result["name"] == "vct-table1" and result["directory"] == str(tmp_path / "py" / "vct-table1")
+    assert result["tables"] == written["tables"]
+    assert result["config"] == written["config"]
+    assert isinstance(result["tables"][0]["rows"][0], dict)
+    assert (tmp_path / "py" / "vct-table1" / "table.md").is_file()
+    assert not list((tmp_path / "py").glob(".*partial"))
+
+
+def test_run_without_results_leaves_nothing(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    result = gilab.run_experiment("core-rays", threads=2)
+    assert result["directory"] is None and result["tables"][0]["rows"]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_unknown_experiment_lists_the_names():
+    with pytest.raises(gilab.Error, match="pm-table1"):
+        gilab.run_experiment("pm-table99")
