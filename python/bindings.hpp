@@ -16,6 +16,8 @@ void register_render_bindings(py::module_& m);
 void register_experiment_bindings(py::module_& m);
 void register_voxel_bindings(py::module_& m);
 void register_octree_bindings(py::module_& m);
+void register_shadow_dag_bindings(py::module_& m);
+void register_multi_frame_dag_bindings(py::module_& m);
 void register_photon_map_bindings(py::module_& m);
 void register_metric_bindings(py::module_& m);
 void register_catalogue_bindings(py::module_& m);

@@ -26,6 +26,9 @@ These bindings wrap the C++ code; they compute nothing of their own:
   read_exr                             EXR files written by gilab
   experiments, run_experiment          the experiment runner
   voxelize, VoxelList, Svo, Esvo, Svdag   sparse voxel structures
+  ShadowDag                            shadow DAG over a light's light space
+  MultiFrameDag, TemporalSvdag,        time-correlated multi-frame DAG
+  build_animation_dag
   PhotonMap                            photon maps with radius / kNN queries
   relative_mse, ssim, flip             image metrics on NumPy arrays
   techniques, scenes, hmd_presets      what is available (as `gilab list`)
@@ -42,6 +45,8 @@ Bad input raises gilab.Error (a ValueError) with the C++ message. Long calls
     register_experiment_bindings(m);
     register_voxel_bindings(m);
     register_octree_bindings(m);
+    register_shadow_dag_bindings(m);
+    register_multi_frame_dag_bindings(m);
     register_photon_map_bindings(m);
     register_metric_bindings(m);
     register_catalogue_bindings(m);
