@@ -219,6 +219,12 @@ std::string approx(double x) {
 
 void Scene::validate() const {
     const std::string where = source.empty() ? name : source;
+    // Mesh references first: triangle_count() and everything below index meshes by them.
+    for (size_t i = 0; i < nodes.size(); ++i)
+        for (uint32_t m : nodes[i].meshes)
+            if (m >= meshes.size())
+                throw Error(where, "node " + std::to_string(i) + " references mesh " + std::to_string(m) +
+                                       " but the scene has " + std::to_string(meshes.size()));
     if (meshes.empty() || triangle_count() == 0) throw Error(where, "scene has no triangles (empty scene)");
     if (!(std::isfinite(frames_per_second) && frames_per_second > 0))
         throw Error(where, "frames per second " + approx(frames_per_second) + " must be a positive number");
@@ -234,10 +240,6 @@ void Scene::validate() const {
         const SceneNode& n = nodes[i];
         if (n.parent >= int(i)) throw Error(where, "node " + std::to_string(i) + " ('" + n.name + "') has parent " +
                                                        std::to_string(n.parent) + " that does not precede it");
-        for (uint32_t m : n.meshes)
-            if (m >= meshes.size())
-                throw Error(where, "node " + std::to_string(i) + " references mesh " + std::to_string(m) +
-                                       " but the scene has " + std::to_string(meshes.size()));
         if (n.skin < 0) continue;
         if (size_t(n.skin) >= skins.size())
             throw Error(where, "node " + std::to_string(i) + " ('" + n.name + "') references skin " +
