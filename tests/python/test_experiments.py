@@ -4,6 +4,7 @@ import json
 import pytest
 
 import gilab
+from conftest import require_shared_asset
 
 
 def test_experiment_list_matches_the_cli(run_cli):
@@ -15,6 +16,7 @@ def test_experiment_list_matches_the_cli(run_cli):
 
 def test_run_experiment_returns_the_cli_tables(tmp_path, run_cli):
     # vct-table1 counts voxels: deterministic, so both runs must agree exactly.
+    require_shared_asset("bunny/stanford-bunny.obj")
     run_cli("experiment", "vct-table1", "--quick", "--results", tmp_path / "cli")
     written = json.loads((tmp_path / "cli" / "vct-table1" / "results.json").read_text())
     result = gilab.run_experiment("vct-table1", quick=True, results=tmp_path / "py", threads=2)
