@@ -4,25 +4,12 @@
 #include <sstream>
 #include "core/image_io.hpp"
 #include "experiments/experiment.hpp"
+#include "experiments/html_report.hpp"
 #include "experiments/result_writers.hpp"
 
 namespace gilab {
 
 namespace {
-
-std::string escape_html(const std::string& s) {
-    std::string out;
-    for (char c : s) {
-        switch (c) {
-            case '<': out += "&lt;"; break;
-            case '>': out += "&gt;"; break;
-            case '&': out += "&amp;"; break;
-            case '"': out += "&quot;"; break;
-            default: out += c;
-        }
-    }
-    return out;
-}
 
 ResultTable comparison_table(const CompareReport& r) {
     ResultTable t;

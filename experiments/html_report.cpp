@@ -15,6 +15,21 @@ namespace gilab {
 
 namespace fs = std::filesystem;
 
+std::string escape_html(const std::string& s) {
+    std::string out;
+    for (char c : s) {
+        switch (c) {
+            case '<': out += "&lt;"; break;
+            case '>': out += "&gt;"; break;
+            case '&': out += "&amp;"; break;
+            case '"': out += "&quot;"; break;
+            case '\'': out += "&#39;"; break;
+            default: out += c;
+        }
+    }
+    return out;
+}
+
 namespace {
 
 using json = nlohmann::json;
@@ -41,21 +56,6 @@ constexpr const char* kStyle =
     "figure{margin:0;flex:0 1 480px;max-width:100%}figure img{width:100%;height:auto}"
     "div.figures.images figure{flex:0 1 16em}div.figures.images img{image-rendering:pixelated}"
     "figcaption{font-size:90%;color:#444}";
-
-std::string escape(const std::string& s) {
-    std::string out;
-    for (char c : s) {
-        switch (c) {
-            case '<': out += "&lt;"; break;
-            case '>': out += "&gt;"; break;
-            case '&': out += "&amp;"; break;
-            case '"': out += "&quot;"; break;
-            case '\'': out += "&#39;"; break;
-            default: out += c;
-        }
-    }
-    return out;
-}
 
 // A relative URL for a path under the results root: every byte but unreserved ones and
 // '/' percent-encoded, so names with '#', '?', '%' or spaces still resolve to the file.
@@ -166,20 +166,20 @@ void write_contents(std::ostringstream& html, const std::vector<std::string>& pa
                     const std::vector<ResultPage>& experiments, const std::vector<ResultPage>& comparisons) {
     html << "<nav id=\"contents\">\n<h2>Contents</h2>\n";
     for (const auto& paper : papers) {
-        html << "<h3>" << escape(paper_title(paper)) << "</h3>\n<ul>\n";
+        html << "<h3>" << escape_html(paper_title(paper)) << "</h3>\n<ul>\n";
         for (const auto& e : experiments)
             if (paper_of(e) == paper) {
                 const std::string description = text_of(e.doc, "description");
-                html << "<li><a href=\"#" << e.anchor << "\">" << escape(experiment_name(e)) << "</a>"
-                     << (description.empty() ? "" : " — " + escape(description)) << "</li>\n";
+                html << "<li><a href=\"#" << e.anchor << "\">" << escape_html(experiment_name(e)) << "</a>"
+                     << (description.empty() ? "" : " — " + escape_html(description)) << "</li>\n";
             }
         html << "</ul>\n";
     }
     if (!comparisons.empty()) {
         html << "<h3>Comparisons against the path-traced reference</h3>\n<ul>\n";
         for (const auto& c : comparisons)
-            html << "<li><a href=\"#" << c.anchor << "\">" << escape(text_of(c.doc, "scene", c.folder)) << "</a> ("
-                 << escape(text_of(c.doc, "views")) << ")</li>\n";
+            html << "<li><a href=\"#" << c.anchor << "\">" << escape_html(text_of(c.doc, "scene", c.folder)) << "</a> ("
+                 << escape_html(text_of(c.doc, "views")) << ")</li>\n";
         html << "</ul>\n";
     }
     html << "</nav>\n";
@@ -190,15 +190,15 @@ bool is_paper_column(const std::string& column) { return column.rfind("paper", 0
 // Wide tables scroll inside their own box rather than widening the page.
 void write_table(std::ostringstream& html, const std::string& title, const std::vector<std::string>& columns,
                  const json& rows) {
-    if (!title.empty()) html << "<h4>" << escape(title) << "</h4>\n";
+    if (!title.empty()) html << "<h4>" << escape_html(title) << "</h4>\n";
     html << "<div class=\"table-scroll\"><table>\n<thead><tr>";
-    for (const auto& c : columns) html << "<th" << (is_paper_column(c) ? " class=\"paper\"" : "") << ">" << escape(c) << "</th>";
+    for (const auto& c : columns) html << "<th" << (is_paper_column(c) ? " class=\"paper\"" : "") << ">" << escape_html(c) << "</th>";
     html << "</tr></thead>\n<tbody>\n";
     for (const auto& row : rows) {
         html << "<tr>";
         for (const auto& c : columns)
             html << "<td" << (is_paper_column(c) ? " class=\"paper\"" : "") << ">"
-                 << escape(row.is_object() && row.contains(c) ? format_cell(row[c]) : "") << "</td>";
+                 << escape_html(row.is_object() && row.contains(c) ? format_cell(row[c]) : "") << "</td>";
         html << "</tr>\n";
     }
     html << "</tbody></table></div>\n";
@@ -210,7 +210,7 @@ void write_notes(std::ostringstream& html, const json& doc) {
         if (n.is_string()) notes.push_back(n.get<std::string>());
     if (notes.empty()) return;
     html << "<ul class=\"notes\">\n";
-    for (const auto& n : notes) html << "<li>" << escape(n) << "</li>\n";
+    for (const auto& n : notes) html << "<li>" << escape_html(n) << "</li>\n";
     html << "</ul>\n";
 }
 
@@ -233,11 +233,11 @@ void write_figures(std::ostringstream& html, const fs::path& root, const std::ve
     if (!present.empty()) {
         html << "<div class=\"figures " << row_class << "\">\n";
         for (const auto& f : present)
-            html << "<figure><img src=\"" << escape(relative_url(f.file)) << "\"><figcaption>" << escape(f.caption)
+            html << "<figure><img src=\"" << escape_html(relative_url(f.file)) << "\"><figcaption>" << escape_html(f.caption)
                  << "</figcaption></figure>\n";
         html << "</div>\n";
     }
-    for (const auto& m : missing) html << "<p class=\"missing\">Listed but missing: " << escape(m) << "</p>\n";
+    for (const auto& m : missing) html << "<p class=\"missing\">Listed but missing: " << escape_html(m) << "</p>\n";
 }
 
 std::vector<Figure> experiment_figures(const ResultPage& page, const std::string& extension) {
@@ -253,14 +253,14 @@ std::vector<Figure> experiment_figures(const ResultPage& page, const std::string
 
 void write_experiment(std::ostringstream& html, const fs::path& root, const ResultPage& page) {
     const json& doc = page.doc;
-    html << "<section class=\"result experiment\" id=\"" << page.anchor << "\">\n<h3>" << escape(experiment_name(page))
-         << "</h3>\n<p class=\"description\">" << escape(text_of(doc, "description")) << "</p>\n";
+    html << "<section class=\"result experiment\" id=\"" << page.anchor << "\">\n<h3>" << escape_html(experiment_name(page))
+         << "</h3>\n<p class=\"description\">" << escape_html(text_of(doc, "description")) << "</p>\n";
     const json machine = doc.value("machine", json::object());
-    html << "<p class=\"run\">revision " << escape(text_of(doc, "git_revision", "?")) << ", seed "
-         << escape(format_cell(doc.value("seed", json()))) << ", " << escape(format_cell(doc.value("threads", json())))
+    html << "<p class=\"run\">revision " << escape_html(text_of(doc, "git_revision", "?")) << ", seed "
+         << escape_html(format_cell(doc.value("seed", json()))) << ", " << escape_html(format_cell(doc.value("threads", json())))
          << " threads" << (doc.value("quick", false) ? ", <b>quick run</b> (reduced sizes, not comparable to the paper)" : "")
-         << ", " << escape(machine.is_object() ? text_of(machine, "cpu", "unknown CPU") : "unknown CPU");
-    if (doc.contains("finished_utc")) html << ", finished " << escape(text_of(doc, "finished_utc"));
+         << ", " << escape_html(machine.is_object() ? text_of(machine, "cpu", "unknown CPU") : "unknown CPU");
+    if (doc.contains("finished_utc")) html << ", finished " << escape_html(text_of(doc, "finished_utc"));
     html << "</p>\n";
     for (const auto& table : doc.value("tables", json::array())) {
         if (!table.is_object()) continue;
@@ -310,13 +310,13 @@ std::vector<Figure> technique_figures(const ResultPage& page, const json& techni
 void write_comparison(std::ostringstream& html, const fs::path& root, const ResultPage& page) {
     const json& doc = page.doc;
     const json techniques = doc.value("techniques", json::array());
-    html << "<section class=\"result comparison\" id=\"" << page.anchor << "\">\n<h3>" << escape(text_of(doc, "scene", page.folder))
-         << "</h3>\n<p class=\"run\">" << escape(text_of(doc, "views")) << ", " << escape(format_cell(doc.value("width", json())))
-         << "×" << escape(format_cell(doc.value("height", json()))) << ", reference "
-         << escape(format_cell(doc.value("reference_spp", json()))) << " spp, median of "
-         << escape(format_cell(doc.value("frames", json()))) << " frames at " << escape(format_cell(doc.value("threads", json())))
-         << " threads, revision " << escape(text_of(doc, "git_revision", "?")) << " — <a href=\""
-         << escape(relative_url(page.folder + "/index.html")) << "\">full comparison page</a> (with 1 − SSIM maps)</p>\n";
+    html << "<section class=\"result comparison\" id=\"" << page.anchor << "\">\n<h3>" << escape_html(text_of(doc, "scene", page.folder))
+         << "</h3>\n<p class=\"run\">" << escape_html(text_of(doc, "views")) << ", " << escape_html(format_cell(doc.value("width", json())))
+         << "×" << escape_html(format_cell(doc.value("height", json()))) << ", reference "
+         << escape_html(format_cell(doc.value("reference_spp", json()))) << " spp, median of "
+         << escape_html(format_cell(doc.value("frames", json()))) << " frames at " << escape_html(format_cell(doc.value("threads", json())))
+         << " threads, revision " << escape_html(text_of(doc, "git_revision", "?")) << " — <a href=\""
+         << escape_html(relative_url(page.folder + "/index.html")) << "\">full comparison page</a> (with 1 − SSIM maps)</p>\n";
     write_comparison_table(html, techniques);
     write_notes(html, doc);
     write_figures(html, root, {reference_figure(page)}, "images");
@@ -354,7 +354,7 @@ int write_html_report(const fs::path& results_root) {
     write_contents(html, papers, experiments, comparisons);
     html << "<main>\n";
     for (const auto& paper : papers) {
-        html << "<h2>" << escape(paper_title(paper)) << "</h2>\n";
+        html << "<h2>" << escape_html(paper_title(paper)) << "</h2>\n";
         for (const auto& e : experiments)
             if (paper_of(e) == paper) write_section(html, results_root, e, write_experiment);
     }

@@ -4,6 +4,7 @@
 // contents grouped by paper, then each experiment's run line, tables, notes, plots and
 // images, then each comparison's table and images, all linked by relative paths.
 #include <filesystem>
+#include <string>
 
 namespace gilab {
 
@@ -12,5 +13,8 @@ namespace gilab {
 // results_root holds neither an experiment's nor a comparison's results.json, or if one
 // of them is malformed.
 int write_html_report(const std::filesystem::path& results_root);
+
+// Text made safe inside HTML elements and quoted attributes (< > & " ').
+std::string escape_html(const std::string& s);
 
 }  // namespace gilab

@@ -139,8 +139,8 @@ ExperimentOutput run(const ExperimentContext& ctx) {
         scene_config[named.name] = {{"resolution", {z.size, z.size}}, {"reference_spp", named.reference_spp},
                                     {"radius", radius}};
         out.notes.push_back(named.name + ": reference = path tracer, " + std::to_string(named.reference_spp) +
-                            " jittered spp at " + std::to_string(z.size) + "², max depth 8; its own noise is a floor "
-                            "under every measured relMSE.");
+                            " jittered spp at " + std::to_string(z.size) + "², max depth 8, on a seed of its own (no variant "
+                            "shares its samples); its own noise is a floor under every measured relMSE.");
 
         std::map<std::string, std::vector<Point>> curves;
         auto record = [&](Point p) {
