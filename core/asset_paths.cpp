@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include "core/build_info.hpp"
 #include "core/error.hpp"
 
 namespace gilab {
@@ -31,7 +32,7 @@ AssetPaths AssetPaths::from_environment(const std::optional<std::string>& flag_v
     std::vector<fs::path> dirs;
     if (flag_value) append_colon_separated(*flag_value, dirs);
     if (const char* env = std::getenv("GILAB_ASSETS")) append_colon_separated(env, dirs);
-    dirs.push_back(fs::path(GILAB_SOURCE_DIR "/../shared/scenes").lexically_normal());
+    dirs.push_back((fs::path(build_source_directory()) / "../shared/scenes").lexically_normal());
     return AssetPaths(std::move(dirs));
 }
 

@@ -22,6 +22,7 @@
 #include <set>
 #include <tuple>
 #include <vector>
+#include "core/build_info.hpp"
 #include "core/error.hpp"
 
 #define STB_IMAGE_WRITE_IMPLEMENTATION
@@ -120,7 +121,7 @@ void add_film_channels(const Film& film, const std::string& path, const Imf::Str
 
 void add_metadata(const Film& film, const std::string& path, Imf::Header& header) {
     auto metadata = film.metadata;
-    metadata.emplace("gitRevision", GILAB_GIT_REVISION);  // kept if the caller set one
+    metadata.emplace("gitRevision", build_git_revision());  // kept if the caller set one
     for (const auto& [key, value] : metadata) {
         if (key.empty()) throw Error(path, "metadata key is empty");
         if (header.find(key) != header.end()) {

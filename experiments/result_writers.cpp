@@ -4,6 +4,7 @@
 #include <fstream>
 #include <sstream>
 #include <thread>
+#include "core/build_info.hpp"
 #include "core/parallel.hpp"
 
 namespace gilab {
@@ -88,6 +89,6 @@ nlohmann::json machine_description() {
     return m;
 }
 
-std::string git_revision() { return GILAB_GIT_REVISION; }
+std::string git_revision() { return build_git_revision(); }
 
 }  // namespace gilab

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <sstream>
+#include "core/build_info.hpp"
 #include "core/error.hpp"
 #include "core/mesh_loaders.hpp"
 #include "core/scene_file.hpp"
@@ -12,7 +13,7 @@ namespace gilab {
 
 namespace fs = std::filesystem;
 
-std::string scenes_directory() { return std::string(GILAB_SOURCE_DIR) + "/scenes"; }
+std::string scenes_directory() { return std::string(build_source_directory()) + "/scenes"; }
 
 std::vector<std::string> scene_file_names() {
     std::vector<std::string> names;

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include "accel/dag_ray_caster.hpp"
+#include "core/build_info.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"
 #include "core/parallel.hpp"
@@ -231,7 +232,7 @@ void DagRaycastTechnique::render(const ViewSet& views, std::vector<Film>& films)
         film.metadata["light"] = shading_light ? shading_light->name : "headlight";
         film.metadata["shadows"] = to_string(shadows_);
         film.metadata["seed"] = std::to_string(settings_.seed);
-        film.metadata["git_revision"] = GILAB_GIT_REVISION;
+        film.metadata["git_revision"] = build_git_revision();
         films[v] = std::move(film);
     }
     const double ms = total.elapsed_ms();

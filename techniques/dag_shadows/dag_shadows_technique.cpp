@@ -1,5 +1,6 @@
 #include "techniques/dag_shadows/dag_shadows_technique.hpp"
 #include <cmath>
+#include "core/build_info.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"
 #include "core/interaction.hpp"
@@ -242,7 +243,7 @@ void DagShadowsTechnique::render(const ViewSet& views, std::vector<Film>& films)
         film.metadata["visibility"] = to_string(settings_.visibility);
         film.metadata["resolution"] = std::to_string(settings_.resolution);
         film.metadata["seed"] = std::to_string(settings_.seed);
-        film.metadata["git_revision"] = GILAB_GIT_REVISION;
+        film.metadata["git_revision"] = build_git_revision();
         films[v] = std::move(film);
     }
     const double ms = total.elapsed_ms();

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <cmath>
 #include "core/bsdf.hpp"
+#include "core/build_info.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"
 #include "core/interaction.hpp"
@@ -10,9 +11,6 @@
 #include "core/progress.hpp"
 #include "core/rng.hpp"
 
-#ifndef GILAB_GIT_REVISION
-#define GILAB_GIT_REVISION "unknown"
-#endif
 
 namespace gilab {
 
@@ -229,7 +227,7 @@ void PathTracer::render(const ViewSet& views, std::vector<Film>& films) {
         film.metadata["max_depth"] = std::to_string(settings_.max_depth);
         film.metadata["rr_depth"] = std::to_string(settings_.rr_depth);
         film.metadata["config_hash"] = config_hash_;
-        film.metadata["git_revision"] = GILAB_GIT_REVISION;
+        film.metadata["git_revision"] = build_git_revision();
         films[v] = std::move(film);
     }
     double ms = watch.elapsed_ms();

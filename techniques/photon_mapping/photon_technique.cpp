@@ -2,14 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include "core/build_info.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"
 #include "techniques/photon_mapping/photon_passes.hpp"
 #include "techniques/photon_mapping/photon_tracer.hpp"
 
-#ifndef GILAB_GIT_REVISION
-#define GILAB_GIT_REVISION "unknown"
-#endif
 
 namespace gilab {
 
@@ -130,7 +128,7 @@ void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& fil
         film.metadata["jitter"] = settings_.sampling.jitter ? "true" : "false";
         if (stereo) film.metadata["stereo_reuse"] = reuse ? to_string(settings_.stereo.match) : "off";
         film.metadata["config_hash"] = config_hash_;
-        film.metadata["git_revision"] = GILAB_GIT_REVISION;
+        film.metadata["git_revision"] = build_git_revision();
         films[v] = std::move(film);
     }
     double ms = watch.elapsed_ms();

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <atomic>
 #include "core/bsdf.hpp"
+#include "core/build_info.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"
 #include "core/interaction.hpp"
@@ -20,9 +21,6 @@
 #include "techniques/photon_mapping/photon_passes.hpp"
 #include "techniques/photon_mapping/photon_tracer.hpp"
 
-#ifndef GILAB_GIT_REVISION
-#define GILAB_GIT_REVISION "unknown"
-#endif
 
 namespace gilab {
 
@@ -194,7 +192,7 @@ void PhotonMappingTechnique::render_progressive(const ViewSet& views, std::vecto
         film.metadata["photon_storage"] = to_string(s.storage);
         film.metadata["seed"] = std::to_string(s.seed);
         film.metadata["config_hash"] = config_hash_;
-        film.metadata["git_revision"] = GILAB_GIT_REVISION;
+        film.metadata["git_revision"] = build_git_revision();
         films[v] = std::move(film);
     }
     const double ms = watch.elapsed_ms();

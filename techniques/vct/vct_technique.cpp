@@ -3,6 +3,7 @@
 #include <atomic>
 #include <cmath>
 #include "core/bsdf.hpp"
+#include "core/build_info.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"
 #include "core/interaction.hpp"
@@ -11,9 +12,6 @@
 #include "core/rng.hpp"
 #include "core/voxel_grid.hpp"
 
-#ifndef GILAB_GIT_REVISION
-#define GILAB_GIT_REVISION "unknown"
-#endif
 
 namespace gilab {
 
@@ -677,7 +675,7 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
         film.metadata["seed"] = std::to_string(settings_.seed);
         film.metadata["frame"] = std::to_string(frame_index_);
         film.metadata["config_hash"] = config_hash_;
-        film.metadata["git_revision"] = GILAB_GIT_REVISION;
+        film.metadata["git_revision"] = build_git_revision();
         films[vi] = std::move(film);
     }
     const double update_ms = stats_.get("update_ms"), injection_ms = stats_.get("injection_ms");
