@@ -18,16 +18,18 @@ constexpr double kFeatureWidth = 0.082;                          // w, degrees
 
 using Rgb = std::array<double, 3>;
 
-// Linear sRGB (D65) ↔ CIE XYZ.
+// Linear sRGB (D65) ↔ CIE XYZ with the matrices of the FLIP papers (Andersson et al.
+// 2020, 2021): the forward one as exact ratios, the inverse as they publish it, so that
+// our FLIP matches theirs rather than a differently rounded sRGB standard.
 Rgb rgb_to_xyz(const Rgb& c) {
-    return {0.4124564 * c[0] + 0.3575761 * c[1] + 0.1804375 * c[2],
-            0.2126729 * c[0] + 0.7151522 * c[1] + 0.0721750 * c[2],
-            0.0193339 * c[0] + 0.1191920 * c[1] + 0.9503041 * c[2]};
+    return {(10135552.0 * c[0] + 8788810.0 * c[1] + 4435075.0 * c[2]) / 24577794.0,
+            (2613072.0 * c[0] + 8788810.0 * c[1] + 887015.0 * c[2]) / 12288897.0,
+            (1425312.0 * c[0] + 8788810.0 * c[1] + 70074185.0 * c[2]) / 73733382.0};
 }
 Rgb xyz_to_rgb(const Rgb& c) {
-    return {3.2404542 * c[0] - 1.5371385 * c[1] - 0.4985314 * c[2],
-            -0.9692660 * c[0] + 1.8760108 * c[1] + 0.0415560 * c[2],
-            0.0556434 * c[0] - 0.2040259 * c[1] + 1.0572252 * c[2]};
+    return {3.241003275 * c[0] - 1.537398934 * c[1] - 0.498615861 * c[2],
+            -0.969224334 * c[0] + 1.875930071 * c[1] + 0.041554224 * c[2],
+            0.055639423 * c[0] - 0.204011202 * c[1] + 1.057148933 * c[2]};
 }
 // The reference white: linear RGB (1, 1, 1).
 const Rgb kWhite = rgb_to_xyz({1.0, 1.0, 1.0});
@@ -158,17 +160,16 @@ Features features(const ImagePlane& y_channel, double ppd) {
 
 }  // namespace
 
-MetricMap flip_map(const Film& image, const Film& reference, const std::string& layer, double ppd, double exposure) {
-    check_comparable_layers(image, reference, layer, "flip");
-    if (!(ppd > 0.0) || !std::isfinite(ppd)) throw Error("flip", "pixels per degree must be positive and finite");
-    const auto test = to_ycxcz(display_planes(image, layer, exposure));
-    const auto ref = to_ycxcz(display_planes(reference, layer, exposure));
+ImagePlane flip_of_display(const std::array<ImagePlane, 3>& image, const std::array<ImagePlane, 3>& reference,
+                           double ppd) {
+    const auto test = to_ycxcz(image);
+    const auto ref = to_ycxcz(reference);
     const std::vector<Rgb> lab_test = perceived_colours(test, ppd), lab_ref = perceived_colours(ref, ppd);
     const Features f_test = features(test[0], ppd), f_ref = features(ref[0], ppd);
 
     const double cmax = max_colour_difference();
-    MetricMap out{ImagePlane(image.width(), image.height()), 0.0};
-    for (size_t i = 0; i < out.map.values.size(); ++i) {
+    ImagePlane out(image[0].width, image[0].height);
+    for (size_t i = 0; i < out.values.size(); ++i) {
         const double d = std::pow(hyab(lab_test[i], lab_ref[i]), kQc);
         const double colour = d < kPc * cmax ? kPt / (kPc * cmax) * d
                                              : kPt + (d - kPc * cmax) / (cmax - kPc * cmax) * (1.0 - kPt);
@@ -176,8 +177,19 @@ MetricMap flip_map(const Film& image, const Film& reference, const std::string& 
             std::max(std::abs(f_test.edges.values[i] - f_ref.edges.values[i]),
                      std::abs(f_test.points.values[i] - f_ref.points.values[i])) / std::sqrt(2.0),
             kQf);
-        out.map.values[i] = float(std::pow(colour, 1.0 - feature));
+        out.values[i] = float(std::pow(colour, 1.0 - feature));
     }
+    return out;
+}
+
+void check_pixels_per_degree(double ppd) {
+    if (!(ppd > 0.0) || !std::isfinite(ppd)) throw Error("flip", "pixels per degree must be positive and finite");
+}
+
+MetricMap flip_map(const Film& image, const Film& reference, const std::string& layer, double ppd, double exposure) {
+    check_comparable_layers(image, reference, layer, "flip");
+    check_pixels_per_degree(ppd);
+    MetricMap out{flip_of_display(display_planes(image, layer, exposure), display_planes(reference, layer, exposure), ppd), 0.0};
     out.mean = out.map.mean();
     return out;
 }

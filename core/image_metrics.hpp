@@ -1,5 +1,6 @@
 #pragma once
 // Image comparisons used by tests and experiments.
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -47,5 +48,32 @@ MetricMap ssim_map(const Film& image, const Film& reference, const std::string& 
 // Edges are clamped.
 MetricMap flip_map(const Film& image, const Film& reference, const std::string& layer = "color",
                    double pixels_per_degree = 67.0, double exposure = 0.0);
+
+// LDR-FLIP of two displayed images given as linear RGB planes in [0, 1] (what flip_map
+// compares after display_planes); the per-pixel map.
+ImagePlane flip_of_display(const std::array<ImagePlane, 3>& image, const std::array<ImagePlane, 3>& reference,
+                           double pixels_per_degree);
+void check_pixels_per_degree(double pixels_per_degree);  // throws unless positive and finite
+
+// HDR-FLIP (Andersson, Nilsson, Shirley & Akenine-Möller 2021, "Visualizing Errors in
+// Rendered High Dynamic Range Images"), for the linear HDR layer itself rather than its
+// clamped display: the exposure range comes from the reference's luminance Y (Rec. 709
+// weights) — start = log2(x_max / max Y), stop = log2(x_min / median Y), where the ACES
+// tone curve reaches 0.85 at x_max = x_min — and is split into
+// max(2, ⌈stop − start⌉) evenly spaced exposures. At each, both images are scaled by
+// 2^exposure, negative values set to 0, tone-mapped by the ACES fit (Narkowicz 2015,
+// with the paper's 0.6 pre-exposure folded into its coefficients) and clamped to
+// [0, 1]; LDR-FLIP compares the results and each pixel keeps its largest error.
+struct HdrFlip {
+    MetricMap flip;
+    double start_exposure = 0, stop_exposure = 0;  // stops
+    int exposures = 0;
+};
+HdrFlip hdr_flip_map(const Film& image, const Film& reference, const std::string& layer = "color",
+                     double pixels_per_degree = 67.0);
+// The ACES fit of HDR-FLIP (0.6-scaled Narkowicz), clamped to [0, 1], and the value it
+// maps to t (x_max = x_min at the paper's t = 0.85).
+double hdr_flip_tone_map(double x);
+double hdr_flip_tone_map_inverse(double t);
 
 }  // namespace gilab

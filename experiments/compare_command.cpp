@@ -45,6 +45,7 @@ const Knob* find_knob(const std::string& technique) {
 void check_request(const CompareRequest& r) {
     if (r.techniques.empty()) throw Error("compare", "no technique given (-t path,photon,vct)");
     for (const auto& t : r.techniques) {
+        if (t.empty()) throw Error("-t", "an empty technique name in the list (two commas, or one at an end)");
         if (!TechniqueRegistry::builtin().find(t)) TechniqueRegistry::builtin().create(t);  // throws listing the known ones
         if (std::count(r.techniques.begin(), r.techniques.end(), t) > 1)
             throw Error("compare", "technique '" + t + "' is listed twice");
@@ -75,6 +76,7 @@ Settings settings_for(const CompareRequest& r, const std::string& technique) {
 
 struct Run {
     double prepare_ms = 0, frame_ms = 0;  // frame: median over the timed renders
+    double timed_ms(EqualTimeOf of) const { return of == EqualTimeOf::Frame ? frame_ms : prepare_ms + frame_ms; }
     size_t peak_rss = 0;
     bool peak_rss_exact = false;  // the peak could be reset before the technique ran
     std::vector<Film> films;
@@ -104,18 +106,29 @@ Run run_technique(const std::string& technique, const Scene& scene, const ViewSe
     return run;
 }
 
-// Raises (or lowers) the technique's quality knob until a frame takes about `budget_ms`,
-// assuming the frame time grows in proportion to the knob; at most five tries.
+// Raises (or lowers) the technique's quality knob until the equalised time (prepare +
+// one frame, or the frame alone) is within 10 % of `budget_ms`; at most five tries. The
+// first step assumes time in proportion to the knob; later ones fit time = a + b · knob
+// through the last two tries, since prepare holds a part (the BVH) that does not scale.
 double tune_knob(const Knob& knob, const std::string& technique, const Scene& scene, const ViewSet& views,
-                 Settings settings, double budget_ms, std::ostream& log) {
+                 Settings settings, double budget_ms, EqualTimeOf of, std::ostream& log) {
     double value = settings.has(knob.setting) ? settings.get<double>(knob.setting, knob.fallback) : knob.fallback;
+    double last_value = 0, last_ms = 0;
     for (int attempt = 0; attempt < 5; ++attempt) {
         settings.set(knob.setting, int64_t(value));
         const Run run = run_technique(technique, scene, views, settings, 1);
-        log << "  " << technique << ": " << knob.setting << "=" << int64_t(value) << " → " << run.frame_ms << " ms a frame" << std::endl;
-        if (std::abs(run.frame_ms - budget_ms) < 0.1 * budget_ms) break;
-        const double next = std::clamp(std::round(value * budget_ms / std::max(run.frame_ms, 1e-3)), knob.low, knob.high);
+        const double ms = run.timed_ms(of);
+        log << "  " << technique << ": " << knob.setting << "=" << int64_t(value) << " → " << ms << " ms ("
+            << to_string(of) << ")" << std::endl;
+        if (std::abs(ms - budget_ms) < 0.1 * budget_ms) break;
+        double next = value * budget_ms / std::max(ms, 1e-3);
+        if (attempt > 0 && value != last_value) {
+            const double slope = (ms - last_ms) / (value - last_value);
+            if (slope > 0) next = value + (budget_ms - ms) / slope;
+        }
+        next = std::clamp(std::round(next), knob.low, knob.high);
         if (next == value) break;
+        last_value = value, last_ms = ms;
         value = next;
     }
     return value;
@@ -147,6 +160,14 @@ std::string folder_name(const std::string& scene) {
 }
 
 }  // namespace
+
+std::string to_string(EqualTimeOf of) { return of == EqualTimeOf::Frame ? "frame" : "prepare + frame"; }
+
+EqualTimeOf parse_equal_time_of(const std::string& text) {
+    if (text == "total") return EqualTimeOf::PrepareAndFrame;
+    if (text == "frame") return EqualTimeOf::Frame;
+    throw Error("--equal-time-of", "'" + text + "' is neither 'total' (prepare + frame) nor 'frame'");
+}
 
 std::string quality_knob(const std::string& technique) {
     const Knob* k = find_knob(technique);
@@ -215,6 +236,7 @@ std::string run_compare(const CompareRequest& request) {
     report.pixels_per_degree = ppd;
     report.frames = request.frames;
     report.equal_time_seconds = request.equal_time_seconds;
+    report.equal_time_of = to_string(request.equal_time_of);
     report.threads = request.threads > 0 ? request.threads : default_thread_count();
 
     for (const std::string& technique : request.techniques) {
@@ -224,7 +246,8 @@ std::string run_compare(const CompareRequest& request) {
         entry.technique = technique;
         if (request.equal_time_seconds) {
             if (const Knob* knob = find_knob(technique)) {
-                const double value = tune_knob(*knob, technique, scene, views, settings, *request.equal_time_seconds * 1000.0, std::cout);
+                const double value = tune_knob(*knob, technique, scene, views, settings, *request.equal_time_seconds * 1000.0,
+                                               request.equal_time_of, std::cout);
                 settings = settings_for(request, technique);
                 settings.set(knob->setting, int64_t(value));
                 entry.knob = std::string(knob->setting) + "=" + std::to_string(int64_t(value));
@@ -239,22 +262,28 @@ std::string run_compare(const CompareRequest& request) {
         entry.peak_rss_exact = run.peak_rss_exact;
         entry.settings = settings.json();
         entry.stats = run.stats.to_json();
-        std::vector<ImagePlane> flip_eyes, ssim_eyes;
+        std::vector<ImagePlane> flip_eyes, hdr_flip_eyes, ssim_eyes;
+        const double eyes = double(run.films.size());
         for (size_t v = 0; v < run.films.size(); ++v) {
-            entry.relmse += relative_mse(run.films[v], reference[v]) / double(run.films.size());
+            entry.relmse += relative_mse(run.films[v], reference[v]) / eyes;
             MetricMap s = ssim_map(run.films[v], reference[v]);
             MetricMap f = flip_map(run.films[v], reference[v], "color", ppd);
-            entry.ssim += s.mean / double(run.films.size());
-            entry.flip += f.mean / double(run.films.size());
+            HdrFlip hdr = hdr_flip_map(run.films[v], reference[v], "color", ppd);
+            entry.ssim += s.mean / eyes;
+            entry.flip += f.mean / eyes;
+            entry.hdr_flip += hdr.flip.mean / eyes;
+            entry.hdr_flip_exposures.push_back({hdr.start_exposure, hdr.stop_exposure, hdr.exposures});
             for (float& x : s.map.values) x = 1.0f - x;  // dissimilarity, 0 where equal
             ssim_eyes.push_back(std::move(s.map));
             flip_eyes.push_back(std::move(f.map));
+            hdr_flip_eyes.push_back(std::move(hdr.flip.map));
         }
         write_images(staging, technique, run.films);
         write_heat_map_png(staging / (technique + "_flip.png"), join_eyes(flip_eyes), 0.0, 1.0);
+        write_heat_map_png(staging / (technique + "_hdrflip.png"), join_eyes(hdr_flip_eyes), 0.0, 1.0);
         write_heat_map_png(staging / (technique + "_ssim.png"), join_eyes(ssim_eyes), 0.0, 1.0);
         std::cout << "  prepare " << entry.prepare_ms << " ms, frame " << entry.frame_ms << " ms, relMSE " << entry.relmse
-                  << ", SSIM " << entry.ssim << ", FLIP " << entry.flip << std::endl;
+                  << ", SSIM " << entry.ssim << ", FLIP " << entry.flip << ", HDR-FLIP " << entry.hdr_flip << std::endl;
         report.entries.push_back(std::move(entry));
     }
     write_compare_report(staging, report);

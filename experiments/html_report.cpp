@@ -280,16 +280,19 @@ void write_comparison_table(std::ostringstream& html, const json& techniques) {
     });
     std::vector<std::string> columns{"technique"};
     if (equal_time) columns.push_back("quality setting at equal time");
-    for (const char* c : {"frame (ms, median)", "relMSE", "SSIM", "FLIP (mean)"}) columns.push_back(c);
+    for (const char* c : {"prepare (ms)", "frame (ms, median)", "relMSE", "SSIM", "FLIP (LDR, mean)", "HDR-FLIP (mean)"})
+        columns.push_back(c);
     json rows = json::array();
     for (const auto& t : techniques) {
         if (!t.is_object()) continue;
         rows.push_back({{"technique", text_of(t, "technique")},
                         {"quality setting at equal time", text_of(t, "quality_setting")},
+                        {"prepare (ms)", t.value("prepare_ms", json())},
                         {"frame (ms, median)", t.value("frame_ms", json())},
                         {"relMSE", t.value("relmse", json())},
                         {"SSIM", t.value("ssim", json())},
-                        {"FLIP (mean)", t.value("flip", json())}});
+                        {"FLIP (LDR, mean)", t.value("flip", json())},
+                        {"HDR-FLIP (mean)", t.value("hdr_flip", json())}});
     }
     write_table(html, "", columns, rows);
 }
@@ -315,8 +318,12 @@ void write_comparison(std::ostringstream& html, const fs::path& root, const Resu
          << "×" << escape_html(format_cell(doc.value("height", json()))) << ", reference "
          << escape_html(format_cell(doc.value("reference_spp", json()))) << " spp, median of "
          << escape_html(format_cell(doc.value("frames", json()))) << " frames at " << escape_html(format_cell(doc.value("threads", json())))
-         << " threads, revision " << escape_html(text_of(doc, "git_revision", "?")) << " — <a href=\""
-         << escape_html(relative_url(page.folder + "/index.html")) << "\">full comparison page</a> (with 1 − SSIM maps)</p>\n";
+         << " threads, revision " << escape_html(text_of(doc, "git_revision", "?"));
+    if (doc.contains("equal_time_seconds"))
+        html << ", equal time of " << escape_html(text_of(doc, "equal_time_of", "frame")) << " at "
+             << escape_html(format_cell(doc.value("equal_time_seconds", json()))) << " s";
+    html << " — <a href=\""
+         << escape_html(relative_url(page.folder + "/index.html")) << "\">full comparison page</a> (HDR-FLIP and 1 − SSIM maps, each image flipping to the reference)</p>\n";
     write_comparison_table(html, techniques);
     write_notes(html, doc);
     write_figures(html, root, {reference_figure(page)}, "images");

@@ -24,6 +24,7 @@
 #include <sstream>
 #include <nlohmann/json.hpp>
 #include "core/error.hpp"
+#include "experiments/compare_report.hpp"
 #include "experiments/html_report.hpp"
 #include "experiments/plot.hpp"
 #include "tests/test_support.hpp"
@@ -365,10 +366,13 @@ struct BrowserLoad {
     std::vector<std::string> errors;         // console errors, failed loads, exceptions
     std::vector<std::string> broken_images;  // <img> that did not decode in the browser
     std::vector<std::string> network;        // requests for anything but a file on disk
+    std::vector<std::string> probes;         // what each probe expression returned, as a string
 };
 
-// Loads the page in a fresh tab and reports what DevTools would show in red.
-BrowserLoad load_in_devtools(const fs::path& page, const fs::path& profile) {
+// Loads the page in a fresh tab and reports what DevTools would show in red; then runs
+// each probe (a JavaScript expression, awaited if it is a promise) as a reader's action
+// would, and keeps its string result. Errors the probes cause count like the page's own.
+BrowserLoad load_in_devtools(const fs::path& page, const fs::path& profile, const std::vector<std::string>& probes = {}) {
     DevTools browser(profile);
     if (!browser.started()) throw gilab::Error(kChromium, "could not start");
     const std::string target =
@@ -389,6 +393,12 @@ BrowserLoad load_in_devtools(const fs::path& page, const fs::path& profile) {
     BrowserLoad load;
     for (const auto& src : json::parse(broken["result"].value("value", std::string("[]"))))
         load.broken_images.push_back(src.get<std::string>());
+    for (const std::string& probe : probes) {
+        const json r = browser.call(
+            "Runtime.evaluate", {{"expression", probe}, {"awaitPromise", true}, {"returnByValue", true}}, session);
+        load.probes.push_back(r.contains("exceptionDetails") ? "exception: " + r["exceptionDetails"].dump()
+                                                             : r["result"].value("value", std::string("(no string)")));
+    }
     for (const json& e : browser.events_until("Page.loadEventFired")) {
         const std::string method = e.value("method", "");
         const json params = e.value("params", json::object());
@@ -547,9 +557,14 @@ TEST(Report, ComparisonsAloneMakeAReportAndNothingIsAnError) {
     EXPECT_TRUE(contains(html, "href=\"#compare-cornell\""));
     EXPECT_TRUE(contains(html, "href=\"compare/cornell/index.html\""));
     EXPECT_FALSE(contains(html, "partial"));
-    for (const char* column : {"technique", "frame (ms, median)", "relMSE", "SSIM", "FLIP (mean)"})
+    for (const char* column : {"technique", "frame (ms, median)", "relMSE", "SSIM", "FLIP (LDR, mean)", "HDR-FLIP (mean)"})
         EXPECT_TRUE(contains(html, std::string("<th>") + column + "</th>")) << column;
     EXPECT_TRUE(contains(html, "<td>2.5</td>"));
+    // What `gilab report` prints at the end of the main job: a line per technique.
+    const std::string summary = gilab::comparison_summary(root);
+    EXPECT_TRUE(contains(summary, "\n  path  cornell 2.5 ms, relMSE 0.1, FLIP 0.05\n")) << summary;
+    EXPECT_FALSE(contains(summary, "partial")) << summary;
+    EXPECT_EQ(gilab::comparison_summary(root / "nothing_here"), "");
     // The images were never written: named, not linked.
     for (const char* image : {"reference.png", "path.png", "path_flip.png"}) {
         EXPECT_TRUE(contains(html, std::string("Listed but missing: compare/cornell/") + image)) << image;
@@ -633,6 +648,31 @@ TEST(ReportBrowser, RealResultsOpenCleanlyInChromium) {
     EXPECT_TRUE(load.errors.empty()) << ::testing::PrintToString(load.errors);
     EXPECT_TRUE(load.broken_images.empty()) << ::testing::PrintToString(load.broken_images);
     EXPECT_TRUE(load.network.empty()) << ::testing::PrintToString(load.network);
+
+    // The comparison page: the toggle flips a technique's image to the reference in place
+    // and back, the reference decodes there, and a click enlarges an image three times.
+    const std::string flip_probe = R"((async () => {
+        const button = document.querySelector('button.flip');
+        const img = document.getElementById(button.dataset.target);
+        const seen = [img.getAttribute('src')];
+        button.click();
+        await img.decode();
+        seen.push(img.getAttribute('src'), String(img.naturalWidth > 0), document.getElementById(button.dataset.target + '-caption').textContent);
+        button.click();
+        await img.decode();
+        seen.push(img.getAttribute('src'));
+        img.click();
+        seen.push(String(img.getBoundingClientRect().width === 3 * img.naturalWidth));
+        return JSON.stringify(seen);
+    })())";
+    const BrowserLoad compare_page = load_in_devtools(root / "compare" / "cornell" / "index.html", root / "profile3", {flip_probe});
+    EXPECT_TRUE(compare_page.errors.empty()) << ::testing::PrintToString(compare_page.errors);
+    EXPECT_TRUE(compare_page.broken_images.empty()) << ::testing::PrintToString(compare_page.broken_images);
+    EXPECT_TRUE(compare_page.network.empty()) << ::testing::PrintToString(compare_page.network);
+    ASSERT_EQ(compare_page.probes.size(), 1u);
+    const std::string flipped_and_back =
+        R"x(["path.png","reference.png","true","reference (path tracer)","path.png","true"])x";
+    EXPECT_EQ(compare_page.probes[0], flipped_and_back);
 
     const ProcessResult shot = screenshot(page, root / "profile2", root / "shot.png");
     EXPECT_EQ(shot.exit_code, 0) << shot.output;

@@ -280,3 +280,12 @@ TEST(Cli, PhotonTakesPixelSamplesAndTechniquesWithoutThemRefuseSpp) {
     expect_failure(args, {"--spp", "'vct' takes no pixel samples"}, bad);
     EXPECT_FALSE(contains(run(args).output, "unknown setting")) << run(args).output;
 }
+
+TEST(Cli, CompareRefusesAnEmptyTechniqueNameAndABadEqualTimeOf) {
+    const fs::path dir = gilab::test::temp_dir("cli_compare_empty_name");
+    for (const char* list : {"path,,photon", ",path", "path,"})
+        expect_failure(std::string("compare cornell -W 8 -H 8 --results ") + dir.string() + " -t " + list,
+                       {"empty technique name"}, dir);
+    expect_failure("compare cornell -W 8 -H 8 --equal-time 1 --equal-time-of frames --results " + dir.string(),
+                   {"--equal-time-of", "'frames'"}, dir);
+}

@@ -44,13 +44,19 @@ TEST(Compare, WritesImagesHeatMapsTableAndFiguresMeasuredAgainstTheReference) {
     const Film reference = read_exr(dir / "reference.exr");
     for (const auto& e : doc["techniques"]) {
         const std::string t = e["technique"];
-        for (const std::string suffix : {".exr", ".png", "_flip.png", "_ssim.png"})
+        for (const std::string suffix : {".exr", ".png", "_flip.png", "_hdrflip.png", "_ssim.png"})
             EXPECT_TRUE(fs::exists(dir / (t + suffix))) << t << suffix;
         // The figures are those of the images written.
         const Film image = read_exr(dir / (t + ".exr"));
         EXPECT_NEAR(e["relmse"].get<double>(), relative_mse(image, reference), 1e-9) << t;
         EXPECT_NEAR(e["ssim"].get<double>(), ssim_map(image, reference).mean, 1e-9) << t;
         EXPECT_NEAR(e["flip"].get<double>(), flip_map(image, reference).mean, 1e-9) << t;
+        const HdrFlip hdr = hdr_flip_map(image, reference);
+        EXPECT_NEAR(e["hdr_flip"].get<double>(), hdr.flip.mean, 1e-9) << t;
+        EXPECT_EQ(e["hdr_flip_exposures"][0]["count"].get<int>(), hdr.exposures) << t;
+        EXPECT_GT(e["hdr_flip"].get<double>(), 0.0);
+        EXPECT_NEAR(e["prepare_plus_frame_ms"].get<double>(), e["prepare_ms"].get<double>() + e["frame_ms"].get<double>(),
+                    1e-9);
         EXPECT_GT(e["frame_ms"].get<double>(), 0.0);
         EXPECT_GT(e["flip"].get<double>(), 0.0);
         EXPECT_LT(e["ssim"].get<double>(), 1.0);
@@ -85,12 +91,39 @@ TEST(Compare, EqualTimeScalesTheQualitySettingAndSaysSo) {
     EXPECT_EQ(quality_knob("dag_raycast"), "");
 }
 
+// A still image's cost is its prepare (the photon pass, the voxelization) and its frame:
+// equal time holds both unless the frame alone is asked for, and the outputs say which.
+TEST(Compare, EqualTimeEqualisesPrepareAndFrameUnlessTheFrameIsAskedFor) {
+    CompareRequest r = small_request("compare_equal_total");
+    r.techniques = {"photon"};
+    r.assignments.clear();
+    r.equal_time_seconds = 0.05;
+    const fs::path dir = run_compare(r);
+    nlohmann::json doc = read_json(dir / "results.json");
+    EXPECT_EQ(doc["equal_time_of"], "prepare + frame");
+    std::ifstream md(dir / "table.md");
+    const std::string table((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
+    EXPECT_NE(table.find("Equal time of prepare + frame"), std::string::npos) << table;
+    EXPECT_NE(table.find("prepare + frame (ms)"), std::string::npos) << table;
+
+    r.equal_time_of = EqualTimeOf::Frame;
+    r.techniques = {"path"};  // the photon frame alone would want millions of photons
+    r.equal_time_seconds = 0.002;
+    doc = read_json(fs::path(run_compare(r)) / "results.json");
+    EXPECT_EQ(doc["equal_time_of"], "frame");
+    EXPECT_EQ(parse_equal_time_of("total"), EqualTimeOf::PrepareAndFrame);
+    EXPECT_EQ(parse_equal_time_of("frame"), EqualTimeOf::Frame);
+    EXPECT_THROW(parse_equal_time_of("prepare"), Error);
+}
+
 TEST(Compare, BadRequestsAreRefusedAndLeaveNothing) {
     CompareRequest r = small_request("compare_bad");
     r.techniques = {"path", "nope"};
     EXPECT_THROW(run_compare(r), Error);
     r.techniques = {"path", "path"};
     EXPECT_THROW(run_compare(r), Error);
+    r.techniques = {"path", "", "photon"};
+    EXPECT_NE(test::error_of([&] { run_compare(r); }).find("empty technique name"), std::string::npos);
     r.techniques = {"path"};
     r.assignments["photon"] = {"radius=0.1"};  // a setting for a technique not compared
     EXPECT_THROW(run_compare(r), Error);

@@ -73,29 +73,16 @@ std::vector<double> plain_ssim(const Film& a, const Film& b) {
 
 using Triple = std::array<double, 3>;
 
+// The FLIP papers' matrices: the forward one as exact ratios, the inverse as published.
 Triple to_xyz(const Triple& c) {
-    return {0.4124564 * c[0] + 0.3575761 * c[1] + 0.1804375 * c[2],
-            0.2126729 * c[0] + 0.7151522 * c[1] + 0.0721750 * c[2],
-            0.0193339 * c[0] + 0.1191920 * c[1] + 0.9503041 * c[2]};
+    return {(10135552.0 * c[0] + 8788810.0 * c[1] + 4435075.0 * c[2]) / 24577794.0,
+            (2613072.0 * c[0] + 8788810.0 * c[1] + 887015.0 * c[2]) / 12288897.0,
+            (1425312.0 * c[0] + 8788810.0 * c[1] + 70074185.0 * c[2]) / 73733382.0};
 }
-// The inverse of to_xyz by Cramer's rule (not the rounded published inverse).
 Triple from_xyz(const Triple& v) {
-    const double m[3][3] = {{0.4124564, 0.3575761, 0.1804375},
-                            {0.2126729, 0.7151522, 0.0721750},
-                            {0.0193339, 0.1191920, 0.9503041}};
-    auto det = [](const double a[3][3]) {
-        return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
-               a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
-    };
-    const double d = det(m);
-    Triple out;
-    for (int k = 0; k < 3; ++k) {
-        double mk[3][3];
-        for (int r = 0; r < 3; ++r)
-            for (int c = 0; c < 3; ++c) mk[r][c] = c == k ? v[size_t(r)] : m[r][c];
-        out[size_t(k)] = det(mk) / d;
-    }
-    return out;
+    return {3.241003275 * v[0] - 1.537398934 * v[1] - 0.498615861 * v[2],
+            -0.969224334 * v[0] + 1.875930071 * v[1] + 0.041554224 * v[2],
+            0.055639423 * v[0] - 0.204011202 * v[1] + 1.057148933 * v[2]};
 }
 const Triple kW = to_xyz({1, 1, 1});
 
@@ -256,10 +243,117 @@ TEST(PerceptualMetrics, ExposureAndClampingFollowThePngPreview) {
     EXPECT_GT(flip_map(a, b, "color", 67.0, -2.0).mean, 0.1);
 }
 
+// ------------------------------------------------------------------ HDR-FLIP
+
+// The published matrices are each other's inverse to the digits they give.
+TEST(PerceptualMetrics, FlipColourMatricesAreTheFlipPapers) {
+    const Triple white = to_xyz({1, 1, 1});
+    EXPECT_NEAR(white[0], 0.950428545, 1e-9);  // the D65 white the FLIP code states
+    EXPECT_NEAR(white[1], 1.0, 1e-12);
+    EXPECT_NEAR(white[2], 1.088900371, 1e-9);
+    for (const Triple& c : {Triple{1, 0, 0}, Triple{0, 1, 0}, Triple{0.2, 0.5, 0.9}}) {
+        const Triple back = from_xyz(to_xyz(c));
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR(back[size_t(k)], c[size_t(k)], 1e-7);
+    }
+}
+
+// Two uniform colours: no filter changes them, so FLIP is the remapped HyAB distance of
+// their Hunt-adjusted L*a*b* through the papers' matrices: 0.892991 here, where the sRGB
+// standard's rounded matrices give 0.893016 (computed in double precision); the library's
+// float planes land within 7e-6 of the former.
+TEST(PerceptualMetrics, FlipOfUniformColoursFollowsTheFlipPapersMatrices) {
+    const Triple a{0.0, 0.0, 1.0}, b{0.0, 0.3, 1.0};
+    auto perceived = [](const Triple& c) {
+        Triple rgb = from_xyz(to_xyz(c));
+        for (double& v : rgb) v = std::clamp(v, 0.0, 1.0);
+        return lab_hunt(rgb);
+    };
+    const double cmax = std::pow(hyab_distance(lab_hunt({0, 1, 0}), lab_hunt({0, 0, 1})), 0.7);
+    const double d = std::pow(hyab_distance(perceived(a), perceived(b)), 0.7);
+    const double expected = d < 0.4 * cmax ? 0.95 / (0.4 * cmax) * d : 0.95 + (d - 0.4 * cmax) / (0.6 * cmax) * 0.05;
+    const MetricMap f = flip_map(constant(12, 12, Vec3(float(a[0]), float(a[1]), float(a[2]))),
+                                 constant(12, 12, Vec3(float(b[0]), float(b[1]), float(b[2]))));
+    EXPECT_NEAR(f.map.at(6, 6), expected, 1e-5);
+    EXPECT_NEAR(expected, 0.892991, 1e-6);
+}
+
+// ACES as HDR-FLIP uses it, from the paper's equation: t(x) = (k0 x² + k1 x) / (k3 x² +
+// k4 x + k5) with k0 = 0.6²·2.51, k1 = 0.6·0.03, k3 = 0.6²·2.43, k4 = 0.6·0.59, k5 = 0.14.
+double aces(double x) {
+    const double k0 = 0.36 * 2.51, k1 = 0.018, k3 = 0.36 * 2.43, k4 = 0.354, k5 = 0.14;
+    return std::clamp((k0 * x * x + k1 * x) / (k3 * x * x + k4 * x + k5), 0.0, 1.0);
+}
+
+TEST(PerceptualMetrics, HdrFlipToneCurveReachesPoint85AtTheExposureTarget) {
+    // (0.9036 − 0.85·0.8748) x² + (0.018 − 0.85·0.354) x − 0.85·0.14 = 0:
+    // 0.16002 x² − 0.2829 x − 0.119 = 0, whose positive root is
+    // (0.2829 + √0.15620193) / 0.32004 = 2.11887 (by hand).
+    EXPECT_NEAR(hdr_flip_tone_map_inverse(0.85), 2.11887, 2e-5);
+    EXPECT_NEAR(hdr_flip_tone_map(2.11887), 0.85, 2e-6);
+    for (double x : {0.0, 0.01, 0.3, 1.0, 7.0, 1e6}) EXPECT_NEAR(hdr_flip_tone_map(x), aces(x), 1e-12) << x;
+    EXPECT_EQ(hdr_flip_tone_map(INFINITY), 1.0);
+}
+
+// Two wide uniform bands of the reference (grey 4 on the left, grey 0.25 on the right)
+// and a test image 25 % brighter everywhere. Far from the band edge no filter sees the
+// edge, so each pixel's LDR-FLIP at an exposure is the remapped colour difference of two
+// uniform greys, and HDR-FLIP is its maximum over the exposures. The exposure range
+// follows from the paper: start = log2(2.11887 / 4), stop = log2(2.11887 / median Y),
+// the median of two equal halves being the mean of 4 and 0.25.
+TEST(PerceptualMetrics, HdrFlipPinnedAtTheEndsOfItsExposureRange) {
+    const int w = 96, h = 8;
+    const double bright = 4.0, dark = 0.25, gain = 1.25;
+    Film ref(w, h), test(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const float v = float(x < w / 2 ? bright : dark);
+            ref.set("color", x, y, Vec3(v));
+            test.set("color", x, y, Vec3(float(v * gain)));
+        }
+    const HdrFlip f = hdr_flip_map(test, ref, "color", 67.0);
+    const double start = std::log2(2.11887 / bright), stop = std::log2(2.11887 / (0.5 * (bright + dark)));
+    EXPECT_NEAR(f.start_exposure, start, 1e-4);  // −0.9167 stops
+    EXPECT_NEAR(f.stop_exposure, stop, 1e-4);    // −0.0042 stops
+    EXPECT_EQ(f.exposures, 2);                   // max(2, ⌈0.91⌉)
+
+    auto lightness = [](double grey) { return 116 * std::cbrt(grey) - 16; };  // Y/Yn = grey
+    const double cmax = std::pow(hyab_distance(lab_hunt({0, 1, 0}), lab_hunt({0, 0, 1})), 0.7);
+    auto uniform_flip = [&](double a, double b) {
+        const double d = std::pow(std::abs(lightness(aces(a)) - lightness(aces(b))), 0.7);
+        return d < 0.4 * cmax ? 0.95 / (0.4 * cmax) * d : 0.95 + (d - 0.4 * cmax) / (cmax - 0.4 * cmax) * 0.05;
+    };
+    for (double grey : {bright, dark}) {
+        double expected = 0;
+        for (double e : {start, stop})
+            expected = std::max(expected, uniform_flip(grey * std::exp2(e), grey * gain * std::exp2(e)));
+        const int x = grey == bright ? 8 : w - 9;  // 8 px from the border, > 20 px from the band edge
+        SCOPED_TRACE(grey);
+        EXPECT_NEAR(f.flip.map.at(x, h / 2), expected, 2e-4);
+        EXPECT_GT(expected, 0.005);
+    }
+    // The bright band is clamped to white on a display, so LDR-FLIP sees no error there:
+    // the case HDR-FLIP exists for.
+    EXPECT_EQ(flip_map(test, ref).map.at(8, h / 2), 0.0f);
+    EXPECT_GT(f.flip.map.at(8, h / 2), 0.01f);
+}
+
+TEST(PerceptualMetrics, HdrFlipOfIdenticalImagesIsZeroAndOfABlackReferenceUsesExposureZero) {
+    const Film a = pattern(24, 16, 1);
+    const HdrFlip same = hdr_flip_map(a, a);
+    EXPECT_EQ(same.flip.mean, 0.0);
+    const Film black = constant(8, 8, Vec3(0.0f)), grey = constant(8, 8, Vec3(0.5f));
+    const HdrFlip f = hdr_flip_map(grey, black);
+    EXPECT_EQ(f.start_exposure, 0.0);
+    EXPECT_EQ(f.stop_exposure, 0.0);
+    EXPECT_GT(f.flip.mean, 0.1);
+}
+
 TEST(PerceptualMetrics, MismatchedImagesAreRefused) {
     EXPECT_THROW(ssim_map(constant(4, 4, Vec3(0.5f)), constant(5, 4, Vec3(0.5f))), Error);
     EXPECT_THROW(flip_map(constant(4, 4, Vec3(0.5f)), constant(4, 4, Vec3(0.5f)), "albedo"), Error);
     EXPECT_THROW(flip_map(constant(4, 4, Vec3(0.5f)), constant(4, 4, Vec3(0.5f)), "color", 0.0), Error);
+    EXPECT_THROW(hdr_flip_map(constant(4, 4, Vec3(0.5f)), constant(5, 4, Vec3(0.5f))), Error);
+    EXPECT_THROW(hdr_flip_map(constant(4, 4, Vec3(0.5f)), constant(4, 4, Vec3(0.5f)), "color", NAN), Error);
 }
 
 }  // namespace
