@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what is missing (Debian 12 packages), builds gilab in Release, then:
-#   ./setup.sh run    renders the stereo Cornell box, runs the quick experiments, compares
-#                     the techniques on the Cornell box and Sponza, writes the report
+#   ./setup.sh run    the main job (scripts/main_job.sh): renders the stereo Cornell box,
+#                     runs the quick experiments, compares the techniques on the Cornell
+#                     box and Sponza, writes the report and prints its path and a summary
 #   ./setup.sh test   runs the whole test suite (CTest), then again built with the
 #                     address and undefined-behaviour sanitizers (build-sanitize/),
 #                     leaving out the tests labelled heavy
@@ -38,19 +39,8 @@ cmake --build build -j "$jobs"
 
 case "$mode" in
   run)
-    ./build/gilab render cornell --hmd vive --spp 16 --output results/render/cornell_stereo
-    ./build/gilab experiment all --quick
-    # The three techniques side by side against a path-traced reference; a scene whose
-    # shared meshes are missing is skipped with the loader's message.
-    for scene in cornell sponza; do
-      if problem="$(./build/gilab info "$scene" 2>&1 >/dev/null)"; then
-        ./build/gilab compare "$scene" -t path,photon,vct
-      else
-        echo "setup: skipping the $scene comparison: $problem"
-      fi
-    done
-    ./build/gilab report
-    echo "setup: results are in $(pwd)/results; open $(pwd)/results/report.html"
+    # The main job's steps live in one script, which the test suite also runs (main_job).
+    scripts/main_job.sh "$(pwd)/build/gilab"
     ;;
   test)
     ctest --test-dir build --output-on-failure --no-tests=error -j "$jobs"

@@ -7,6 +7,7 @@
 #include "core/memory_budget.hpp"
 #include "core/parallel.hpp"
 #include "experiments/compare_command.hpp"
+#include "experiments/compare_report.hpp"
 #include "experiments/experiment.hpp"
 #include "experiments/experiment_batch.hpp"
 #include "experiments/html_report.hpp"
@@ -153,9 +154,14 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     compare->add_option("--frames", compare_request.frames, "renders per technique; the median time is reported")
         ->capture_default_str();
+    std::string equal_time_of = "total";
     compare->add_option("--equal-time", compare_request.equal_time_seconds,
-                        "seconds per frame: scale each technique's quality setting (path spp, photon photons, vct "
-                        "diffuse_cones) until a frame takes about this long");
+                        "seconds: scale each technique's quality setting (path spp, photon photons, vct diffuse_cones) "
+                        "until the time of --equal-time-of is about this long");
+    compare->add_option("--equal-time-of", equal_time_of,
+                        "what --equal-time equalises: total (prepare + one frame, the work that makes a still image) "
+                        "or frame (the frame alone, prepare amortised as in an animation)")
+        ->capture_default_str();
     compare->add_option("--ppd", compare_request.pixels_per_degree,
                         "FLIP viewing condition in pixels per degree (default 67, a monitor; with --hmd the headset's "
                         "own: width / horizontal field of view)");
@@ -165,7 +171,8 @@ int main(int argc, char** argv) {
     compare->add_option("--seed", seed, "random seed")->capture_default_str();
 
     std::string report_dir = "results";
-    auto* report = app.add_subcommand("report", "gather every results/NAME/results.json into results/report.html");
+    auto* report = app.add_subcommand("report", "gather every results/NAME/results.json into results/report.html and "
+                                                "print a summary of the comparisons (frame time, relMSE, FLIP)");
     report->add_option("--results", report_dir, "results root directory")->capture_default_str();
 
     CLI11_PARSE(app, argc, argv);
@@ -186,8 +193,9 @@ int main(int argc, char** argv) {
         } else if (*compare) {
             compare_request.techniques.clear();
             std::stringstream list(compare_techniques);
-            for (std::string t; std::getline(list, t, ',');)
-                if (!t.empty()) compare_request.techniques.push_back(t);
+            for (std::string t; std::getline(list, t, ',');) compare_request.techniques.push_back(t);
+            if (!compare_techniques.empty() && compare_techniques.back() == ',') compare_request.techniques.push_back("");
+            compare_request.equal_time_of = parse_equal_time_of(equal_time_of);
             for (const auto& s : compare_settings) {
                 const auto eq = s.find('=');
                 if (eq == std::string::npos || eq == 0) throw Error("--settings", "'" + s + "' is not TECHNIQUE=FILE");
@@ -205,6 +213,7 @@ int main(int argc, char** argv) {
             std::cout << "wrote " << folder << "/index.html\n";
         } else if (*report) {
             int n = write_html_report(report_dir);
+            std::cout << comparison_summary(report_dir);
             std::cout << "wrote " << (std::filesystem::path(report_dir) / "report.html").string() << " (" << n
                       << " experiments)\n";
         } else if (*experiment) {

@@ -11,6 +11,22 @@ void register_errors(py::module_& m) {
         "Bad input: the message names where the problem is (file, file:line, setting or argument) and what is wrong.";
 }
 
+// The module is built for one interpreter (GILAB_PYTHON_EXECUTABLE, chosen by CMake) and
+// hands out NumPy arrays; another interpreter of the same version may load it and lack
+// NumPy. Fail at import with the interpreter to use, not at the first array.
+void require_numpy() {
+    try {
+        py::module_::import("numpy");
+    } catch (py::error_already_set&) {
+        const std::string here = py::module_::import("sys").attr("executable").cast<std::string>();
+        throw py::import_error("gilab needs NumPy, which this interpreter (" + here +
+                               ") cannot import. The module was built for " GILAB_PYTHON_EXECUTABLE
+                               " (Python " GILAB_PYTHON_VERSION "), which has Debian's python3-numpy: run it with that "
+                               "interpreter, or rebuild with cmake -DPython3_EXECUTABLE=<yours> after installing NumPy "
+                               "and pybind11 for it.");
+    }
+}
+
 }  // namespace gilab::python
 
 PYBIND11_MODULE(gilab, m) {
@@ -37,6 +53,7 @@ These bindings wrap the C++ code; they compute nothing of their own:
 Bad input raises gilab.Error (a ValueError) with the C++ message. Long calls
 (renders, builds, experiments) release the GIL.
 )doc";
+    require_numpy();
     register_errors(m);
     register_film_bindings(m);
     register_camera_bindings(m);
