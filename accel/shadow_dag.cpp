@@ -98,6 +98,7 @@ ShadowDag ShadowDag::build(int grid_depth, const TileFill& fill, const ShadowDag
 
     ShadowDag dag;
     dag.depth_ = grid_depth;
+    dag.undefined_as_ = undefined_as;
     ShadowDagBuildStats& st = dag.stats_;
     st.tile_texels = tile;
     ShadowDagMerger merger(grid_depth);
@@ -241,7 +242,7 @@ bool ShadowDag::lit_at(const DVec3& c, Cursor& cursor) const {
     const double n = space_ ? double(space_->resolution()) : double(octree_size());
     if (!(c.x >= 0 && c.y >= 0 && c.x < n && c.y < n) || !(c.z >= 0)) return true;
     const uint32_t z = uint32_t(std::min(c.z, double(octree_size() - 1)));
-    return state_is_lit(voxel_state(UVec3(uint32_t(c.x), uint32_t(c.y), z), cursor));
+    return state_is_lit(voxel_state(UVec3(uint32_t(c.x), uint32_t(c.y), z), cursor), undefined_as_);
 }
 
 float ShadowDag::visibility(const Vec3& p, const Vec3& normal, int pcf, Cursor& cursor) const {

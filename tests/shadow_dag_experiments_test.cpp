@@ -59,7 +59,7 @@ TEST(ShadowDagExperiments, Table4Storage) {
     // has nothing closed, so S3 = S2 exactly.
     EXPECT_LT((*villa)["S3 / S2"].get<double>(), 0.8);
     EXPECT_DOUBLE_EQ((*terrain)["S3 / S2"].get<double>(), 1.0);
-    EXPECT_DOUBLE_EQ((*terrain)["S3, undefined as shadow (MB)"].get<double>(), (*terrain)["S3 (MB)"].get<double>());
+    EXPECT_DOUBLE_EQ((*terrain)["S3, undefined as lit (MB)"].get<double>(), (*terrain)["S3 (MB)"].get<double>());
 }
 
 TEST(ShadowDagExperiments, Fig15Growth) {
