@@ -63,8 +63,9 @@ public:
     // sees no geometry. `scene` supplies the closed-mesh check for double depth maps.
     static ShadowDag build(const Scene& scene, const RayTracer& tracer, const PunctualLight& light,
                            const ShadowDagOptions& options);
-    // The coarse look build() takes first: whether the light sees any geometry of the
-    // tracer's frame in its view volume (512² depth rays).
+    // The look build() takes first: whether any triangle of the tracer's frame may lie in
+    // the light's view volume (LightSpace::may_overlap_triangle: conservative, so thin or
+    // tiny geometry between depth-map rays is never dropped).
     static bool light_sees_geometry(const RayTracer& tracer, const PunctualLight& light);
     // Builds from depth tiles given by `fill` (tests, or depth maps from elsewhere):
     // fill(x0, y0, size, tile) must fill the tile for that texel square. Of `options`,

@@ -566,6 +566,64 @@ TEST(ShadowDag, PointLightCubeMatchesShadowRaysUpToOneVoxelOfABoundary) {
     EXPECT_EQ(face.position, light.position);
 }
 
+// Which cube faces of a point light hold a DAG is decided per triangle, not by rays
+// through texel centres: a triangle far smaller than the gap between the 512² rays of
+// the +x face, placed between four of them, still gives that face its DAG (thin geometry
+// such as fire particles would otherwise lose its shadow without a word).
+TEST(ShadowDag, PointLightFaceHoldingOnlyATinyTriangleGetsItsDag) {
+    PunctualLight light;
+    light.name = "point";
+    light.type = LightType::Point;
+    light.position = Vec3(0);
+    const PunctualLight face = LightShadowDags::cube_face(light, 0);  // +x
+    // The directions of four neighbouring rays of a 512² look at the +x face; the
+    // triangle sits where they meet, at axial distance 1, a tenth of their spacing wide.
+    const Bounds3 unit{Vec3(-1), Vec3(1)};
+    const LightSpace probe(face, unit, 512);
+    Vec3 mid(0);
+    for (uint32_t k = 0; k < 4; ++k) {
+        const Vec3 d = probe.texel_ray(255 + (k & 1), 255 + (k >> 1)).direction;
+        mid += d / glm::dot(d, face.direction) / 4.0f;
+    }
+    const float spacing = 2 * std::tan(LightShadowDags::kCubeFaceHalfAngleDegrees * kPi / 180.0f) / 512;
+    const float h = 0.05f * spacing;
+    Scene scene;
+    scene.name = "tiny-triangle";
+    scene.source = "builtin:tiny-triangle";
+    scene.materials.push_back(Material{});
+    Mesh tiny;
+    tiny.positions = {mid + Vec3(0, -h, -h), mid + Vec3(0, h, -h), mid + Vec3(0, 0, h)};
+    tiny.triangles = {{0, 1, 2}};
+    tiny.material_ids = {0};
+    scene.add_mesh_instance(tiny);
+    Mesh ground;  // below the light, in the −y face only
+    ground.positions = {{-0.5f, -1, -0.5f}, {0.5f, -1, -0.5f}, {0.5f, -1, 0.5f}, {-0.5f, -1, 0.5f}};
+    ground.triangles = {{0, 2, 1}, {0, 3, 2}};
+    ground.material_ids = {0, 0};
+    scene.add_mesh_instance(ground);
+    scene.lights.push_back(light);
+    const SceneFrame frame = scene.evaluate(0);
+    const RayTracer tracer(frame);
+    // No ray of the look hits it: the triangle is found by the triangle test alone.
+    for (uint32_t y = 250; y < 262; ++y)
+        for (uint32_t x = 250; x < 262; ++x) {
+            Ray r = probe.texel_ray(x, y);
+            r.origin = light.position;
+            ASSERT_FALSE(tracer.intersect(r).valid()) << x << "," << y;
+        }
+    ShadowDagOptions o;
+    o.resolution = 64;
+    const LightShadowDags dags = LightShadowDags::build(scene, tracer, light, o);
+    EXPECT_TRUE(dags.dag(0).has_value()) << "the +x face holds the tiny triangle";
+    EXPECT_TRUE(dags.dag(3).has_value()) << "the −y face holds the ground";
+    EXPECT_EQ(dags.dag_count(), 2u);
+    // A triangle wholly outside a face's frustum (behind it, or past one side) is not counted.
+    const LightSpace plus_x(face, unit, 64);
+    EXPECT_TRUE(plus_x.may_overlap_triangle(tiny.positions[0], tiny.positions[1], tiny.positions[2]));
+    EXPECT_FALSE(plus_x.may_overlap_triangle(Vec3(-1, 0, 0), Vec3(-1, 0.1f, 0), Vec3(-1, 0, 0.1f)));
+    EXPECT_FALSE(plus_x.may_overlap_triangle(Vec3(1, 2, 0), Vec3(1, 2.1f, 0), Vec3(1, 2, 0.1f)));
+}
+
 TEST(ShadowDag, SpotLightMatchesShadowRaysUpToOneVoxelOfABoundary) {
     expect_matches_rays(LightType::Spot, true, false);
     expect_matches_rays(LightType::Spot, true, true);
