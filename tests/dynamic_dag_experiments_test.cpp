@@ -155,6 +155,7 @@ TEST(DynamicDagExperiments, Table6FrameRates) {
                 EXPECT_EQ(num(row, "rays per frame (rays)"), pixels) << row.dump();
             EXPECT_GT(num(row, "fps (frames/s)"), 0) << row.dump();
             EXPECT_GT(num(row, "1 thread fps (frames/s)"), 0) << row.dump();
+            EXPECT_NEAR(num(row, "fps (frames/s)"), 1000.0 / num(row, "frame median (ms)"), 1e-6);
             // A frame rate at another image size is no measure of the paper's: no ratio.
             EXPECT_TRUE(row["ours / paper fps (×)"].is_null()) << row.dump();
             EXPECT_TRUE(row["1 thread / paper fps (×)"].is_null()) << row.dump();
