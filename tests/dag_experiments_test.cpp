@@ -177,9 +177,10 @@ TEST_F(DagExperimentsTest, Table3TimesArePositiveAndSplitMatchesWhole) {
             EXPECT_EQ(num(row, "paper_t_A_ms"), it->second.first);
             EXPECT_EQ(num(row, "paper_t_B_ms"), it->second.second);
             // The paper is compared with our 1-thread figure, of the same phase (whole rows).
-            if (!split)
+            if (!split) {
                 EXPECT_DOUBLE_EQ(num(row, "speedup_vs_paper_t_A (1 thread)"),
                                  it->second.first / num(row, "t_A_ms (1 thread)"));
+            }
         }
     }
     EXPECT_GT(split_rows, 0u);

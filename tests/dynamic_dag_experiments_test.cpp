@@ -149,10 +149,11 @@ TEST(DynamicDagExperiments, Table6FrameRates) {
             // One primary ray per pixel; shadow rays through the DAG add to them, shadow
             // DAG lookups do not.
             const double pixels = double(w) * h;
-            if (row["shadows"] == "dag_ray")
+            if (row["shadows"] == "dag_ray") {
                 EXPECT_GE(num(row, "rays per frame (rays)"), pixels) << row.dump();
-            else
+            } else {
                 EXPECT_EQ(num(row, "rays per frame (rays)"), pixels) << row.dump();
+            }
             EXPECT_GT(num(row, "fps (frames/s)"), 0) << row.dump();
             EXPECT_GT(num(row, "1 thread fps (frames/s)"), 0) << row.dump();
             EXPECT_NEAR(num(row, "fps (frames/s)"), 1000.0 / num(row, "frame median (ms)"), 1e-6);

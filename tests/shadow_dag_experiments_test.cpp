@@ -78,7 +78,9 @@ TEST(ShadowDagExperiments, Fig15Growth) {
         EXPECT_LT(g2, 4.0) << row.dump();
         EXPECT_GT(g3, 1.0) << row.dump();
         EXPECT_LE(g3, g2 * (1 + 1e-12)) << row.dump();
-        if (row["scene"] == "fbm_terrain") EXPECT_DOUBLE_EQ(g3, g2) << row.dump();
+        if (row["scene"] == "fbm_terrain") {
+            EXPECT_DOUBLE_EQ(g3, g2) << row.dump();
+        }
         if (row["scene"] == "villa" && row["N → 2N"] == "500 → 1000") {
             villa = true;
             EXPECT_TRUE(row["paper S2 growth"].is_null());  // the paper's doublings start at 1000
