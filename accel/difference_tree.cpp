@@ -15,6 +15,7 @@ DifferenceTree::DifferenceTree(const VoxelGrid& grid) : grid_(grid) {
     depth_ = grid_.depth();
     levels_.resize(depth_ + 1);
     level_counts_.assign(depth_ + 1, 0);
+    level_pointers_.assign(depth_ + 1, 0);
     previous_codes_.resize(depth_ + 1);
     previous_ids_.resize(depth_ + 1);
 }
@@ -28,7 +29,7 @@ uint32_t DifferenceTree::store(int level, uint32_t mask, const uint32_t* kids, u
     lv.records.push_back(mask);
     lv.records.insert(lv.records.end(), kids, kids + count);
     ++level_counts_[level];
-    pointer_total_ += count;
+    level_pointers_[level] += count;
     return id;
 }
 
@@ -145,6 +146,19 @@ double DifferenceTree::nodes_per_frame() const {
     return roots_.empty() ? 0.0 : double(node_count()) / double(roots_.size());
 }
 
-size_t DifferenceTree::bytes() const { return 4 * (node_count() + pointer_total_ + roots_.size()); }
+size_t DifferenceTree::bytes() const {
+    uint64_t pointers = 0;
+    for (uint64_t p : level_pointers_) pointers += p;
+    return 4 * (node_count() + pointers + roots_.size());
+}
+
+uint64_t DifferenceTree::node_count_leaves_in_masks() const { return node_count() - level_counts_[depth_]; }
+
+size_t DifferenceTree::bytes_leaves_in_masks() const {
+    // Pointers of the levels above the bottom nodes only: a bottom node's mask is its voxels.
+    uint64_t pointers = 0;
+    for (int l = 0; l + 1 < depth_; ++l) pointers += level_pointers_[size_t(l)];
+    return 4 * (node_count_leaves_in_masks() + pointers + roots_.size());
+}
 
 }  // namespace gilab

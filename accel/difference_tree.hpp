@@ -7,7 +7,12 @@
 // multi-frame DAG removes.
 //
 // Nodes are stored like SVDAG nodes (children need not be contiguous): a mask word and
-// one 32-bit pointer per child; leaf voxels are nodes too, as in the SVO counts.
+// one 32-bit pointer per child; leaf voxels are nodes too, as in the SVO counts. That
+// costs 8 B per changed voxel (its word and its parent's pointer to it). The SVDAG and
+// the time-correlated DAG keep the voxel level in their parents' masks instead; the
+// *_leaves_in_masks figures count the tree stored that way, so the baseline is priced
+// like the structures it is compared with. Which nodes a frame adds does not change:
+// a bottom node whose mask is unchanged has exactly the same voxels.
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -32,6 +37,10 @@ public:
     const std::vector<uint64_t>& level_node_counts() const { return level_counts_; }  // depth+1 entries
     // 4 B mask word + 4 B per child pointer per stored node + 4 B root per frame.
     size_t bytes() const;
+    // The same tree with the voxel level held in the masks of the level above it: no
+    // voxel nodes and no pointers to them.
+    uint64_t node_count_leaves_in_masks() const;
+    size_t bytes_leaves_in_masks() const;
 
     static constexpr uint32_t kEmptyFrame = 0xffffffffu;
 
@@ -51,9 +60,9 @@ private:
     int depth_ = 0;
     std::vector<Level> levels_;
     std::vector<uint64_t> level_counts_;
+    std::vector<uint64_t> level_pointers_;  // child pointers stored by the nodes of each level
     std::vector<uint32_t> roots_;
     std::vector<uint64_t> added_;
-    size_t pointer_total_ = 0;
     // The previous frame's nodes per level: ascending codes and their ids.
     std::vector<std::vector<uint64_t>> previous_codes_;
     std::vector<std::vector<uint32_t>> previous_ids_;

@@ -18,6 +18,19 @@ Vec3 face_normal(const WorldMesh& mesh, uint32_t triangle) {
 // (interpenetrating meshes); past it the texel is treated as open.
 constexpr int kMaxExitSteps = 16;
 
+// Where a closed part's undefined space ends (D2) in a column entered at d1 and left at
+// `exit`. Lookup points are moved up to 2.5 voxels off a surface (LightSpace::
+// lookup_coords), so a surface lying inside the part (`inner`: the first other surface
+// met between entry and exit, +inf if none) or touching it at the exit (`touching`)
+// has its lookups land in the part's interior, which the merge rules may fold into lit.
+// Ending the undefined space a band before such a surface stores the space its lookups
+// reach as shadow, as a plain depth map would answer them: the band is the bias plus a
+// voxel of quantization and a voxel of the surface's slope across a texel.
+float undefined_end(float d1, float exit, float inner, bool touching) {
+    const float end = std::min(touching ? exit - kContactBandVoxels : exit, inner - kContactBandVoxels);
+    return std::max(d1, end);
+}
+
 // Sign of (outward normal · ray direction): < 0 entering the part, > 0 leaving it.
 float facing(const SceneFrame& frame, const ClosedSurfaces& closed, const Hit& h, const Vec3& direction) {
     const Vec3 n = face_normal(frame.meshes[h.mesh], h.triangle) * float(closed.outward[h.mesh][h.triangle]);
@@ -63,6 +76,7 @@ ClosedSurfaces closed_surfaces(const Scene& scene, const SceneFrame& frame) {
     return out;
 }
 
+
 void LightDepthTile::render(const RayTracer& tracer, const LightSpace& space, const ClosedSurfaces* closed,
                             uint32_t x0, uint32_t y0, uint32_t size) {
     if (size == 0 || (size & (size - 1))) throw Error("light depth map", "tile size must be a power of two");
@@ -94,8 +108,14 @@ void LightDepthTile::render(const RayTracer& tracer, const LightSpace& space, co
                 uint32_t texel;
                 uint32_t mesh;
                 int32_t part;
+                float inner = kInfinity;  // depth of the first other surface met inside the part
             };
             std::vector<Search> searches;
+            struct Exit {
+                uint32_t texel;
+                float depth, inner;
+            };
+            std::vector<Exit> exits;
             for (uint32_t i = 0; i < count; ++i) {
                 const Hit& h = hits[i];
                 if (!h.valid()) continue;
@@ -103,7 +123,7 @@ void LightDepthTile::render(const RayTracer& tracer, const LightSpace& space, co
                 if (!closed || closed->empty() || closed->component[h.mesh].empty()) continue;
                 const int32_t part = closed->component[h.mesh][h.triangle];
                 if (part < 0 || facing(frame, *closed, h, rays[i].direction) >= 0) continue;
-                searches.push_back({i, h.mesh, part});
+                searches.push_back({i, h.mesh, part, kInfinity});
                 rays[i].tmin = h.t;
             }
             // The continuation rays keep their texel's place in a full-row stream (the rest
@@ -126,20 +146,41 @@ void LightDepthTile::render(const RayTracer& tracer, const LightSpace& space, co
                 cast += searches.size();
                 size_t kept = 0;
                 for (size_t k = 0; k < searches.size(); ++k) {
-                    const Search& q = searches[k];
+                    Search q = searches[k];
                     const Hit& e = exit_hits[q.texel];
                     if (!e.valid()) continue;  // slipped out of the part unseen: leave the texel open
                     if (e.mesh != q.mesh || closed->component[e.mesh][e.triangle] != q.part) {
                         rays[q.texel].tmin = e.t;  // another surface inside: look further
+                        q.inner = std::min(q.inner, e.t);
                         searches[kept++] = q;
                         continue;
                     }
                     // The exit is a face of the same part turned away from the light; a
                     // face turned toward it means the real exit was missed (a ray through
                     // a shared edge): leave the texel open rather than guess.
-                    if (facing(frame, *closed, e, rays[q.texel].direction) > 0) d2[q.texel] = e.t;
+                    if (facing(frame, *closed, e, rays[q.texel].direction) > 0) exits.push_back({q.texel, e.t, q.inner});
                 }
                 searches.resize(kept);
+            }
+            // Does another surface begin within the band behind the exit (a part resting on
+            // or against this one)? One short ray per exit, again as one full-row stream.
+            for (uint32_t i = 0; i < count; ++i) {
+                exit_rays[i] = rays[i];
+                exit_rays[i].tmin = 1.0f;
+                exit_rays[i].tmax = 0.0f;
+            }
+            for (const Exit& x : exits) {
+                Ray& r = exit_rays[x.texel];
+                r.tmin = x.depth + std::max(1e-4f, x.depth * 1e-6f);
+                r.tmax = x.depth + kContactBandVoxels;
+            }
+            if (!exits.empty()) {
+                tracer.intersect(exit_rays, exit_hits);
+                cast += exits.size();
+            }
+            for (const Exit& x : exits) {
+                const bool touching = exit_hits[x.texel].valid();
+                d2[x.texel] = undefined_end(d1[x.texel], x.depth, x.inner, touching);
             }
             row_rays[row] = cast;
         }

@@ -6,7 +6,10 @@
 //    through its outside; D2 = D1 for open meshes (no undefined region) and for the
 //    plain depth map.
 // The voxel (x, y, z) of the column is lit when its centre z + 0.5 < D1, undefined when
-// D1 ≤ z + 0.5 < D2, and in shadow when z + 0.5 ≥ D2. Two pyramids of aligned
+// D1 ≤ z + 0.5 < D2, and in shadow when z + 0.5 ≥ D2. Where another surface lies inside
+// the part or touches it at the exit (a contact), D2 is moved kContactBandVoxels in front
+// of that surface: the lookups of that surface land there and must read shadow, not the
+// lit that the merge rules may fold undefined space into. Two pyramids of aligned
 // power-of-two blocks (max D1, min D2) tell for any aligned cell whether it holds a lit
 // voxel (max D1 > its first centre) and a shadow voxel (min D2 ≤ its last centre).
 #include <cstdint>
@@ -17,6 +20,9 @@
 #include "core/scene.hpp"
 
 namespace gilab {
+
+// Undefined space ends this many voxels before a surface inside or touching a closed part.
+inline constexpr float kContactBandVoxels = 4.0f;
 
 // The closed surfaces of a frame, per connected component of each mesh (CGAL's check on
 // the source mesh): a model of many closed parts counts part by part. For each world

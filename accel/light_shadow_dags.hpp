@@ -4,7 +4,9 @@
 // the faces of a cube around it. Each face's frustum is widened from 45° to 46° half-angle
 // so that a lookup point, which is moved a few voxels off the surface (LightSpace::
 // lookup_coords), still falls inside the face it was assigned to near a seam. A face that
-// sees no geometry holds no DAG, and points assigned to it are lit.
+// has no triangle overlapping its frustum (a conservative test of every triangle, so a
+// face holding only tiny or thin geometry still gets its DAG) holds no DAG, and points
+// assigned to it are lit.
 #include <array>
 #include <cstddef>
 #include <optional>

@@ -122,6 +122,20 @@ DVec3 LightSpace::to_light(const Vec3& p) const {
     return DVec3((px * 0.5 + 0.5) * n_, (py * 0.5 + 0.5) * n_, (z - near_) / (far_ - near_) * n_);
 }
 
+bool LightSpace::may_overlap_triangle(const Vec3& a, const Vec3& b, const Vec3& c) const {
+    if (!perspective_) return true;
+    // Each plane as (side, up-or-right axis sign): outside when ±(r·axis) > tan · (r·dir).
+    const Vec3 r[3] = {a - position_, b - position_, c - position_};
+    auto all_outside = [&](const Vec3& axis, float sign) {
+        for (const Vec3& q : r)
+            if (sign * glm::dot(q, axis) <= float(tan_half_) * glm::dot(q, dir_)) return false;
+        return true;
+    };
+    if (all_outside(right_, 1) || all_outside(right_, -1) || all_outside(up_, 1) || all_outside(up_, -1)) return false;
+    const bool behind = glm::dot(r[0], dir_) <= 0 && glm::dot(r[1], dir_) <= 0 && glm::dot(r[2], dir_) <= 0;
+    return !behind;
+}
+
 float LightSpace::voxel_world_size(const Vec3& p) const {
     if (!perspective_) return float(std::max({ext_.x, ext_.y, ext_.z}) / n_);
     const double z = std::max(glm::dot(p - position_, dir_), float(near_));

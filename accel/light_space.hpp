@@ -44,6 +44,11 @@ public:
     // lit surface does not shadow itself through depth quantization ("acne"). Both the
     // shadow map and the shadow DAGs look up this same point.
     DVec3 lookup_coords(const Vec3& p, const Vec3& normal) const;
+    // Whether the triangle may overlap the view volume: false only when all three corners
+    // lie outside one of its bounding planes (the four sides of a spot frustum and the
+    // plane through the light), so no triangle that overlaps is ever missed, however
+    // small. A directional light's box encloses the scene: always true.
+    bool may_overlap_triangle(const Vec3& a, const Vec3& b, const Vec3& c) const;
     // World size of one voxel near p (the larger of its across-beam and depth sizes).
     float voxel_world_size(const Vec3& p) const;
     // Unit direction from p toward the light.

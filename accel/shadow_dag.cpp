@@ -13,7 +13,6 @@ namespace {
 
 constexpr uint32_t kDefaultTile = 2048;
 constexpr int kMaxSplitLevel = 6;
-constexpr uint32_t kProbeResolution = 512;
 
 // Merges cell SVOs bottom-up into the shared per-level tables and joins the cells.
 class ShadowDagMerger {
@@ -98,6 +97,7 @@ ShadowDag ShadowDag::build(int grid_depth, const TileFill& fill, const ShadowDag
 
     ShadowDag dag;
     dag.depth_ = grid_depth;
+    dag.undefined_as_ = undefined_as;
     ShadowDagBuildStats& st = dag.stats_;
     st.tile_texels = tile;
     ShadowDagMerger merger(grid_depth);
@@ -178,10 +178,10 @@ ShadowDag ShadowDag::build(int grid_depth, const TileFill& fill, const ShadowDag
 ShadowDag ShadowDag::build(const Scene& scene, const RayTracer& tracer, const PunctualLight& light,
                            const ShadowDagOptions& options) {
     const LightSpace space(light, tracer.frame().bounds, options.resolution);
-    // A coarse look first, so a light that sees nothing is refused at once.
+    // A cheap look first, so a light that sees nothing is refused at once.
     if (!light_sees_geometry(tracer, light))
         throw Error("shadow DAG (light '" + light.name + "')",
-                    "the light sees no geometry in its view volume (probed at 512² rays)");
+                    "the light sees no geometry in its view volume (no triangle overlaps it)");
     Stopwatch closed_clock;
     const ClosedSurfaces closed = options.double_depth ? closed_surfaces(scene, tracer.frame()) : ClosedSurfaces{};
     const double closed_ms = closed_clock.elapsed_ms();
@@ -196,11 +196,15 @@ ShadowDag ShadowDag::build(const Scene& scene, const RayTracer& tracer, const Pu
 }
 
 bool ShadowDag::light_sees_geometry(const RayTracer& tracer, const PunctualLight& light) {
-    if (!LightSpace::faces_any_of(light, tracer.frame().bounds)) return false;
-    const LightSpace probe(light, tracer.frame().bounds, kProbeResolution);
-    LightDepthTile t;
-    t.render(tracer, probe, nullptr, 0, 0, kProbeResolution);
-    return t.any_hit();
+    const SceneFrame& frame = tracer.frame();
+    if (!LightSpace::faces_any_of(light, frame.bounds)) return false;
+    // Every triangle against the view volume, not rays through texel centres: a triangle
+    // smaller than the gaps between rays (a fire particle) must still count.
+    const LightSpace space(light, frame.bounds, 8);  // the frustum only; the resolution does not matter
+    for (const WorldMesh& m : frame.meshes)
+        for (const UVec3& t : m.triangles)
+            if (space.may_overlap_triangle(m.positions[t.x], m.positions[t.y], m.positions[t.z])) return true;
+    return false;
 }
 
 size_t ShadowDag::node_count() const {
@@ -241,7 +245,7 @@ bool ShadowDag::lit_at(const DVec3& c, Cursor& cursor) const {
     const double n = space_ ? double(space_->resolution()) : double(octree_size());
     if (!(c.x >= 0 && c.y >= 0 && c.x < n && c.y < n) || !(c.z >= 0)) return true;
     const uint32_t z = uint32_t(std::min(c.z, double(octree_size() - 1)));
-    return state_is_lit(voxel_state(UVec3(uint32_t(c.x), uint32_t(c.y), z), cursor));
+    return state_is_lit(voxel_state(UVec3(uint32_t(c.x), uint32_t(c.y), z), cursor), undefined_as_);
 }
 
 float ShadowDag::visibility(const Vec3& p, const Vec3& normal, int pcf, Cursor& cursor) const {

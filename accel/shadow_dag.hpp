@@ -33,9 +33,10 @@ struct ShadowDagOptions {
     uint32_t resolution = 1024;  // voxels per axis of the light-space grid
     bool double_depth = false;   // S3: fold closed objects' interiors (§3.2)
     uint32_t tile_texels = 0;    // x–y tile side (power of two); 0: min(octree size, 2048)
-    // How undefined space left inside Boundary nodes and mixed leaves is stored (Lit or
-    // Shadow; see ShadowSvo). Without closed geometry there is none and it changes nothing.
-    ShadowState undefined_as = ShadowState::Lit;
+    // How undefined space left inside Boundary nodes and mixed leaves is stored, and what
+    // a lookup in a wholly undefined node answers (Lit or Shadow; see state_is_lit for
+    // why Shadow). Without closed geometry there is none and it changes nothing.
+    ShadowState undefined_as = ShadowState::Shadow;
     std::function<void(double)> progress;  // fraction of tiles done, may be empty
     size_t memory_limit_bytes = 0;         // depth tiles and merge tables; 0 = half the RAM
 };
@@ -62,8 +63,9 @@ public:
     // sees no geometry. `scene` supplies the closed-mesh check for double depth maps.
     static ShadowDag build(const Scene& scene, const RayTracer& tracer, const PunctualLight& light,
                            const ShadowDagOptions& options);
-    // The coarse look build() takes first: whether the light sees any geometry of the
-    // tracer's frame in its view volume (512² depth rays).
+    // The look build() takes first: whether any triangle of the tracer's frame may lie in
+    // the light's view volume (LightSpace::may_overlap_triangle: conservative, so thin or
+    // tiny geometry between depth-map rays is never dropped).
     static bool light_sees_geometry(const RayTracer& tracer, const PunctualLight& light);
     // Builds from depth tiles given by `fill` (tests, or depth maps from elsewhere):
     // fill(x0, y0, size, tile) must fill the tile for that texel square. Of `options`,
@@ -75,6 +77,7 @@ public:
     uint32_t octree_size() const { return 1u << depth_; }
     const std::optional<LightSpace>& space() const { return space_; }
     ShadowState root_state() const { return root_state_; }
+    ShadowState undefined_as() const { return undefined_as_; }  // what undefined space answers
     std::span<const uint32_t> words() const { return words_; }
 
     // Stored size: every word of every node and leaf.
@@ -101,7 +104,8 @@ public:
     }
     ShadowState voxel_state(const UVec3& voxel, Cursor& cursor) const;
     // The answer for light-space coordinates: lit outside the grid's x–y square and in
-    // front of it; past its far end the last layer answers.
+    // front of it; past its far end the last layer answers; undefined space answers as
+    // undefined_as().
     bool lit_at(const DVec3& light_coords) const {
         Cursor fresh;
         return lit_at(light_coords, fresh);
@@ -129,6 +133,7 @@ private:
     int depth_ = 0;
     std::optional<LightSpace> space_;
     ShadowState root_state_ = ShadowState::Lit;
+    ShadowState undefined_as_ = ShadowState::Shadow;
     std::vector<uint32_t> words_;
     std::vector<uint64_t> level_counts_;
     std::vector<uint64_t> level_begin_;

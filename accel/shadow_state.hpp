@@ -57,9 +57,16 @@ inline ShadowState stored_child_state(ShadowState s, ShadowState undefined_as) {
     return s == ShadowState::Undefined ? undefined_as : s;
 }
 
-// What a lookup that ends on a state answers. Undefined space lies inside closed
-// objects; the only lookups that land there are of a lit surface whose bias fell short
-// of the depth quantization (grazing light), so it reads as lit.
-inline bool state_is_lit(ShadowState s) { return s != ShadowState::Shadow; }
+// What a lookup that ends on a state answers; a wholly undefined node answers as the
+// build stored the rest of its undefined space (`undefined_as`), so one choice holds
+// for every undefined voxel. Undefined space lies inside the closed part the light
+// meets first, behind its entry depth D1. A lookup point lands there when the bias
+// (1.5 voxels off the surface, 1 toward the light) carries it into a closed part that
+// touches the surface looked up: a contact, where that part stands between the surface
+// and the light. Answering as a plain depth map does at D1 (behind it: shadow) is then
+// right; answering lit leaks light under every contact. Shadow is the default.
+inline bool state_is_lit(ShadowState s, ShadowState undefined_as = ShadowState::Shadow) {
+    return s == ShadowState::Lit || (s == ShadowState::Undefined && undefined_as == ShadowState::Lit);
+}
 
 }  // namespace gilab

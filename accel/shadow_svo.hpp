@@ -29,7 +29,7 @@ public:
     // The octree of the cell at `cell_level` whose minimum voxel is `cell_first`, in a
     // grid of octree depth `grid_depth` (≥ 3). The cell's columns must lie in `tile`.
     static ShadowSvo build(const LightDepthTile& tile, const UVec3& cell_first, int cell_level, int grid_depth,
-                           ShadowState undefined_as = ShadowState::Lit);
+                           ShadowState undefined_as = ShadowState::Shadow);
 
     ShadowState root_state() const { return root_state_; }  // Boundary: the tree below exists
     int cell_level() const { return cell_level_; }

@@ -112,6 +112,8 @@ struct Table5Figures {
     size_t svo_bytes = 0, svo_pointerless_bytes = 0, max_frame_svo_bytes = 0;
     uint64_t diff_nodes = 0, diff_steady_nodes = 0;  // steady: Σ_{f≥1} changed_f
     size_t diff_bytes = 0;
+    uint64_t diff_mask_leaf_nodes = 0;  // the same tree with the voxels in the bottom masks
+    size_t diff_mask_leaf_bytes = 0;
     uint64_t svdag_nodes = 0;           // Σ_f |DAG_f|
     size_t svdag_bytes = 0;
     TemporalSvdag tc;                   // from the incremental build
@@ -182,6 +184,8 @@ Table5Figures measure_table5(const OpenedDynamicScene& s, uint32_t resolution, i
     f.voxels_per_frame = double(voxels) / double(frames);
     f.diff_nodes = diff.node_count();
     f.diff_bytes = diff.bytes();
+    f.diff_mask_leaf_nodes = diff.node_count_leaves_in_masks();
+    f.diff_mask_leaf_bytes = diff.bytes_leaves_in_masks();
     double reachable = 0;
     for (size_t k = 0; k < f.tc.frame_count(); ++k) reachable += double(f.tc.reachable_node_count(k));
     f.tc_reachable_per_frame = reachable / double(frames);
@@ -218,6 +222,8 @@ void add_table5_rows(const OpenedDynamicScene& s, const Table5Figures& f, Result
     c["diff N_p (nodes)"] = double(f.diff_nodes) / frames;
     c["diff N_p steady (nodes)"] = f.frames > 1 ? json(double(f.diff_steady_nodes) / (frames - 1)) : json(nullptr);
     c["diff N_n (nodes)"] = f.diff_nodes;
+    c["diff, leaves in masks N_p (nodes)"] = double(f.diff_mask_leaf_nodes) / frames;
+    c["diff, leaves in masks N_n (nodes)"] = f.diff_mask_leaf_nodes;
     c["SVDAG N_p (nodes)"] = double(f.svdag_nodes) / frames;
     c["SVDAG N_n (nodes)"] = f.svdag_nodes;
     c["TC N_p (nodes)"] = f.tc.nodes_per_frame();
@@ -225,6 +231,7 @@ void add_table5_rows(const OpenedDynamicScene& s, const Table5Figures& f, Result
     c["TC reachable per frame (nodes)"] = f.tc_reachable_per_frame;
     c["SVO/TC N_n (×)"] = ratio(double(f.svo_nodes), tc_nn);
     c["diff/TC N_n (×)"] = ratio(double(f.diff_nodes), tc_nn);
+    c["diff, leaves in masks/TC N_n (×)"] = ratio(double(f.diff_mask_leaf_nodes), tc_nn);
     c["SVDAG/TC N_n (×)"] = ratio(double(f.svdag_nodes), tc_nn);
     c["paper SVO/TC N_n (×)"] = p.svo_nn / p.tc_nn;
     c["paper diff/TC N_n (×)"] = p.diff_nn / p.tc_nn;
@@ -247,6 +254,7 @@ void add_table5_rows(const OpenedDynamicScene& s, const Table5Figures& f, Result
     m["SVO pointerless (MB)"] = mb(double(f.svo_pointerless_bytes));
     m["SVO stored (MB)"] = mb(double(f.svo_bytes));
     m["diff 32-bit (MB)"] = mb(double(f.diff_bytes));
+    m["diff, leaves in masks 32-bit (MB)"] = mb(double(f.diff_mask_leaf_bytes));
     m["SVDAG 32-bit (MB)"] = mb(double(f.svdag_bytes));
     m["TC 32-bit (MB)"] = mb(double(f.tc.bytes()));
     m["TC minimal bits, offsets (MB)"] = mb(double(f.minbits_offset_bytes));
@@ -297,15 +305,16 @@ ExperimentOutput run_table5(const ExperimentContext& ctx) {
                    "SVDAG, time-correlated DAG (TC)";
     counts.columns = {"scene", "paper scene", "resolution (voxels/axis)", "frames", "voxels per frame (mean)",
                       "SVO N_p (nodes)", "SVO N_n (nodes)", "diff N_p (nodes)", "diff N_p steady (nodes)",
-                      "diff N_n (nodes)", "SVDAG N_p (nodes)", "SVDAG N_n (nodes)", "TC N_p (nodes)",
+                      "diff N_n (nodes)", "diff, leaves in masks N_p (nodes)", "diff, leaves in masks N_n (nodes)",
+                      "SVDAG N_p (nodes)", "SVDAG N_n (nodes)", "TC N_p (nodes)",
                       "TC N_n (nodes)", "TC reachable per frame (nodes)", "SVO/TC N_n (×)", "diff/TC N_n (×)",
-                      "SVDAG/TC N_n (×)", "paper SVO/TC N_n (×)", "paper diff/TC N_n (×)",
+                      "diff, leaves in masks/TC N_n (×)", "SVDAG/TC N_n (×)", "paper SVO/TC N_n (×)", "paper diff/TC N_n (×)",
                       "paper SVDAG/TC N_n (×)", "paper SVO N_p (nodes)", "paper SVO N_n (nodes)",
                       "paper diff N_p (nodes)", "paper diff N_n (nodes)", "paper SVDAG N_p (nodes)",
                       "paper SVDAG N_n (nodes)", "paper TC N_p (nodes)", "paper TC N_n (nodes)"};
     storage.title = "Table 5 — storage (MB = 10⁶ B) with 32-bit and minimal-bit pointers";
     storage.columns = {"scene", "resolution (voxels/axis)", "frames", "SVO pointerless (MB)", "SVO stored (MB)",
-                       "diff 32-bit (MB)", "SVDAG 32-bit (MB)", "TC 32-bit (MB)", "TC minimal bits, offsets (MB)",
+                       "diff 32-bit (MB)", "diff, leaves in masks 32-bit (MB)", "SVDAG 32-bit (MB)", "TC 32-bit (MB)", "TC minimal bits, offsets (MB)",
                        "TC minimal bits, indices (MB)", "TC minimal bits, offsets, per frame (MB)",
                        "TC minimal bits, offsets, per voxel-frame (bits)", "paper Kämpe 2016 (MB)",
                        "paper Kämpe 2016 frames (frames)"};
@@ -352,6 +361,8 @@ ExperimentOutput run_table5(const ExperimentContext& ctx) {
         "SVO and SVDAG: N_n = Σ over frames of the frame's nodes, N_p = N_n / F. Difference tree (Ma & Shen 2000, "
         "path copying): N_n = frame 0's SVO plus, per later frame, every node whose voxels below differ from the "
         "previous frame's at the same place; N_p = N_n / F, and 'diff N_p steady' is the mean over frames 1..F−1 only. "
+        "'diff, leaves in masks' is the same tree with the voxel level held in the child masks of the level above (as "
+        "the SVDAG and TC DAG hold it): no voxel nodes, and no pointers to them. "
         "Time-correlated DAG: N_n = one root per non-empty frame plus the unique nodes below shared across space and "
         "time; N_p = N_n / F. 'TC reachable per frame' is the mean number of nodes under one frame's root, which equals "
         "the per-frame SVDAG N_p when the merge is right.");
@@ -362,7 +373,8 @@ ExperimentOutput run_table5(const ExperimentContext& ctx) {
     out.notes.push_back(
         "Storage: 32-bit = 4 B per node word (8-bit child mask) + 4 B per child pointer (P2 §2.2); the TC layout stores "
         "one root node per frame in time order and needs no root table. Difference tree: the same node format plus a "
-        "4 B root per frame. SVO: pointerless 1 B per node, and as stored (1 B mask per node + 4 B first-child index "
+        "4 B root per frame; with voxels as nodes each changed voxel costs 8 B (its word and its parent's pointer), "
+        "with leaves in masks nothing beyond its bottom node's copy. SVO: pointerless 1 B per node, and as stored (1 B mask per node + 4 B first-child index "
         "per inner node). Minimal bits (our reading of Kämpe et al. 2016, whose body text we could not check): the "
         "laid-out TC DAG as a dense bitstream, per node an 8-bit mask and one pointer per child of ⌈log2⌉ of the next "
         "level's bits (offsets: traversable) or of its node count (indices: a lower bound that needs an index table), "
@@ -403,6 +415,9 @@ ExperimentOutput run_table5(const ExperimentContext& ctx) {
 struct ImageSize {
     int width, height;
     std::string paper_size;  // the paper's size this row stands for
+    std::string pixels() const { return std::to_string(width) + "×" + std::to_string(height); }
+    // A frame rate compares with the paper's only at the paper's own image size.
+    bool is_paper_size() const { return pixels() == paper_size; }
 };
 
 struct FrameTimes {
@@ -488,7 +503,7 @@ ExperimentOutput run_table6(const ExperimentContext& ctx) {
                 json row;
                 row["scene"] = s.name;
                 row["paper scene"] = s.paper_scene;
-                row["image (pixels)"] = std::to_string(size.width) + "×" + std::to_string(size.height);
+                row["image (pixels)"] = size.pixels();
                 row["stands for (pixels)"] = size.paper_size;
                 row["resolution (voxels/axis)"] = resolution;
                 row["frames"] = frames;
@@ -506,8 +521,9 @@ ExperimentOutput run_table6(const ExperimentContext& ctx) {
                 row["1 thread frame median (ms)"] = one.median_ms;
                 row["1 thread fps (frames/s)"] = fps1;
                 row["paper CPU fps (frames/s)"] = paper_fps;
-                row["ours / paper fps (×)"] = fps / paper_fps;
-                row["1 thread / paper fps (×)"] = fps1 / paper_fps;
+                // Left empty when the image is smaller than the paper's (quick runs).
+                row["ours / paper fps (×)"] = size.is_paper_size() ? json(fps / paper_fps) : json(nullptr);
+                row["1 thread / paper fps (×)"] = size.is_paper_size() ? json(fps1 / paper_fps) : json(nullptr);
                 const bool has_shadow_dags = prepared.has("shadow_dag_bytes");
                 row["shadow DAGs, all frames (MB)"] =
                     has_shadow_dags ? json(mb(prepared.get("shadow_dag_bytes"))) : json(nullptr);
@@ -551,7 +567,9 @@ ExperimentOutput run_table6(const ExperimentContext& ctx) {
         "through the same frame's DAG. Each image size renders every frame in order after one warm-up frame; a frame's time is "
         "update + render, and fps = 1000 / the median frame time. The same is repeated at 1 thread (ThreadLimit), "
         "and with shadows off ('primary only', all threads), since the paper does not say whether its figures "
-        "include shadows. frame_<scene>.png: frame F/2 at the largest size.");
+        "include shadows. frame_<scene>.png: frame F/2 at the largest size. 'ours / paper' is filled only where the "
+        "image is the paper's own size (full runs); a row whose image differs from the size it stands for leaves it "
+        "empty, since frame time scales with the pixel count.");
     out.notes.push_back(
         "The paper's figures are CPU-only frame rates on its own machine and scenes (Kitchen and Robot from "
         "Chalmers); ours run on this machine's " + std::to_string(default_thread_count()) +

@@ -188,7 +188,7 @@ lit_at(light_coords) or voxel_states(voxels).
              return out;
          },
          "scene"_a, "light"_a = py::none(), "resolution"_a = 1024, "double_depth"_a = false, "time"_a = 0.0,
-         "tile_texels"_a = 0, "undefined_as"_a = "lit", R"doc(Renders the light's depth maps over the scene at `time` and builds the DAG
+         "tile_texels"_a = 0, "undefined_as"_a = "shadow", R"doc(Renders the light's depth maps over the scene at `time` and builds the DAG
 (ShadowDag::build; the GIL is released).
 
 scene          a gilab.Scene
@@ -203,8 +203,11 @@ double_depth   False: S2, the plain depth map. True: S3, double depth maps —
 time           scene time in seconds
 tile_texels    side of the x–y tiles built one at a time (power of two;
                0: min(octree size, 2048)); the DAG does not depend on it
-undefined_as   "lit" or "shadow": how undefined space left inside boundary
-               nodes is stored (S3 only)
+undefined_as   "shadow" or "lit": how undefined space left inside boundary
+               nodes is stored and what lookups there answer (S3 only).
+               "shadow" (default) answers as a plain depth map at D1: a
+               lookup pushed by the bias into a closed part that touches
+               the surface is behind that part
 
 Raises gilab.Error for a point light, a bad resolution or tile, or a light
 that sees no geometry.
@@ -244,7 +247,7 @@ that sees no geometry.
                     o);
                 return out;
             },
-            "d1"_a, "d2"_a = py::none(), "tile_texels"_a = 0, "undefined_as"_a = "lit",
+            "d1"_a, "d2"_a = py::none(), "tile_texels"_a = 0, "undefined_as"_a = "shadow",
             R"doc(Builds the DAG from depth maps given as arrays (ShadowDag::build over
 LightDepthTile::assign): d1 and d2 are (S, S) float arrays indexed [y, x], S a
 power of two from 8 up, depths in voxel units along the beam (+inf: no hit).

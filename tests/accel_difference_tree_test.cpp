@@ -146,3 +146,25 @@ TEST(DifferenceTree, BadInputIsAnError) {
     EXPECT_THROW(tree.decode(0), Error);
     EXPECT_EQ(tree.frame_count(), 0u);
 }
+
+// Two frames on an 8³ grid (depth 3), counted by hand. Frame 0: voxel 0; frame 1 adds
+// voxel 1 beside it, so the bottom node's mask changes and its whole path is copied.
+//  * voxels as nodes: frame 0 stores 4 nodes (root, two inner, the voxel) and 3
+//    pointers, frame 1 stores 4 nodes (the new voxel, three copies) and 4 pointers (the
+//    bottom node now points at two voxels): 4 B × (8 nodes + 7 pointers + 2 roots) = 68 B;
+//  * voxels in the bottom masks: 3 nodes and 2 pointers per frame, 2 roots: 4 B × 12 = 48 B.
+TEST(DifferenceTree, LeavesInMasksDropTheVoxelNodesAndTheirPointers) {
+    DifferenceTree tree(gilab::test::unit_grid(8));
+    ASSERT_EQ(tree.depth(), 3);
+    EXPECT_EQ(tree.append_frame(std::vector<uint64_t>{0}), 4u);
+    EXPECT_EQ(tree.append_frame(std::vector<uint64_t>{0, 1}), 4u);
+    EXPECT_EQ(tree.node_count(), 8u);
+    EXPECT_EQ(tree.bytes(), 68u);
+    EXPECT_EQ(tree.node_count_leaves_in_masks(), 6u);
+    EXPECT_EQ(tree.bytes_leaves_in_masks(), 48u);
+    // A third frame moving the second voxel within the same bottom node: the voxel
+    // variant stores the new voxel too, the mask variant only the three copies.
+    tree.append_frame(std::vector<uint64_t>{0, 2});
+    EXPECT_EQ(tree.bytes(), 68u + 4 * (4 + 4 + 1));
+    EXPECT_EQ(tree.bytes_leaves_in_masks(), 48u + 4 * (3 + 2 + 1));
+}

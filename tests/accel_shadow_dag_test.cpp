@@ -12,6 +12,7 @@
 #include "core/parallel.hpp"
 #include "core/ray_tracer.hpp"
 #include "core/scene.hpp"
+#include "scenes/shadow_scenes.hpp"
 #include "test_support.hpp"
 
 using namespace gilab;
@@ -60,7 +61,8 @@ Maps make_maps(uint32_t size, bool closed, uint32_t seed) {
     return m;
 }
 
-ShadowDag dag_from_maps(const Maps& m, int depth, uint32_t tile, ShadowState undefined_as = S::Lit) {
+ShadowDag dag_from_maps(const Maps& m, int depth, uint32_t tile,
+                        ShadowState undefined_as = ShadowDagOptions{}.undefined_as) {
     ShadowDagOptions o;
     o.tile_texels = tile;
     o.undefined_as = undefined_as;
@@ -136,8 +138,8 @@ TEST(ShadowSvo, StatesFollowThePaperRulesBottomUp) {
                 for (int s = 0; s < 8; ++s) {
                     const UVec3 c = cells[j] + UVec3(s & 1, (s >> 1) & 1, (s >> 2) & 1) * half;
                     const S want = reference_state(m, c, half);
-                    // Undefined children of a boundary node are stored as lit (the default).
-                    ASSERT_EQ(child_state(svo.masks(i)[j], s), stored_child_state(want, S::Lit))
+                    // Undefined children of a boundary node are stored as shadow (the default).
+                    ASSERT_EQ(child_state(svo.masks(i)[j], s), stored_child_state(want, S::Shadow))
                         << "closed " << closed << " level " << i;
                     ++checked;
                     if (want == S::Boundary) next.push_back(c);
@@ -150,7 +152,7 @@ TEST(ShadowSvo, StatesFollowThePaperRulesBottomUp) {
             for (uint32_t k = 0; k < 64; ++k) {
                 const UVec3 v = cells[j] + UVec3(k & 3, (k >> 2) & 3, k >> 4);
                 const bool shadow = (svo.leaves()[j] >> k) & 1;
-                EXPECT_EQ(shadow, m.voxel(v.x, v.y, v.z) == S::Shadow);
+                EXPECT_EQ(shadow, m.voxel(v.x, v.y, v.z) != S::Lit);  // undefined voxels too, by default
             }
         EXPECT_GT(checked, 100u);
     }
@@ -205,6 +207,63 @@ TEST(ShadowDag, DoubleDepthAgreesOutsideClosedGeometryAndIsSmaller) {
     EXPECT_GT(compared, 200000u);
     EXPECT_LT(b.bytes(), a.bytes());
   }
+}
+
+namespace {
+
+// What the paper's tree holds for a voxel: the state of the first cell on its path that
+// the rules do not subdivide (at the 4³ leaves, the voxel's own state).
+ShadowState folded_state(const Maps& m, const UVec3& v, uint32_t grid) {
+    for (uint32_t size = grid; size >= 4; size /= 2) {
+        const UVec3 first = v / size * size;
+        const ShadowState s = reference_state(m, first, size);
+        if (s != S::Boundary) return s;
+    }
+    return m.voxel(v.x, v.y, v.z);
+}
+
+}  // namespace
+
+// A closed block (undefined inside) beside an open surface at depth 10: the 8³ cells they
+// share hold lit, shadow and undefined voxels, so they are subdivided and the block's
+// all-undefined 4³ leaves become children of boundary nodes. This is a contact: a
+// lookup moved off the open surface by the bias lands inside the block. Undefined space
+// the rules leave must answer shadow, as a plain depth map does behind D1; the old
+// storage (and today's undefined_as = Lit option) answers lit there.
+TEST(ShadowDag, UndefinedSpaceLeftByTheRulesAnswersShadow) {
+    Maps m;
+    m.size = 32;
+    m.d1.assign(32 * 32, kInfinity);
+    m.d2 = m.d1;
+    for (uint32_t y = 0; y < 32; ++y)
+        for (uint32_t x = 0; x < 32; ++x) {
+            const size_t i = size_t(y) * 32 + x;
+            if (x < 14) {
+                m.d1[i] = 2;   // the closed block, entered at 2 and left at 30
+                m.d2[i] = 30;
+            } else if (x < 20) {
+                m.d1[i] = m.d2[i] = 10;  // an open surface touching it
+            }
+        }
+    const ShadowDag shadow = dag_from_maps(m, 5, 32);
+    const ShadowDag lit = dag_from_maps(m, 5, 32, S::Lit);
+    EXPECT_EQ(ShadowDagOptions{}.undefined_as, S::Shadow);
+    size_t undefined = 0;
+    for (uint32_t z = 0; z < 32; ++z)
+        for (uint32_t y = 0; y < 32; ++y)
+            for (uint32_t x = 0; x < 32; ++x) {
+                const UVec3 v(x, y, z);
+                const DVec3 centre(x + 0.5, y + 0.5, z + 0.5);
+                const S want = folded_state(m, v, 32);
+                if (want != S::Undefined) {
+                    ASSERT_EQ(shadow.lit_at(centre), want == S::Lit) << x << "," << y << "," << z;
+                    continue;
+                }
+                ++undefined;
+                ASSERT_FALSE(shadow.lit_at(centre)) << "undefined voxel answers lit at " << x << "," << y << "," << z;
+                ASSERT_TRUE(lit.lit_at(centre)) << x << "," << y << "," << z;
+            }
+    EXPECT_GT(undefined, 500u);  // the rules leave undefined space next to the contact
 }
 
 TEST(DagLayout, CanonicalOrderIgnoresInsertionOrder) {
@@ -394,6 +453,73 @@ void expect_matches_rays(LightType type, bool closed_boxes, bool double_depth) {
 
 }  // namespace
 
+namespace {
+
+// Random points on the frame's surfaces, by area, whose normal faces the light with
+// n·L > 0.2 (as the Python check does).
+std::vector<Surface> surface_points_facing(const SceneFrame& frame, const Vec3& to_light, size_t count) {
+    std::vector<std::pair<const WorldMesh*, UVec3>> triangles;
+    std::vector<double> areas;
+    for (const WorldMesh& m : frame.meshes)
+        for (const UVec3& t : m.triangles) {
+            triangles.push_back({&m, t});
+            areas.push_back(glm::length(glm::cross(m.positions[t.y] - m.positions[t.x], m.positions[t.z] - m.positions[t.x])));
+        }
+    std::mt19937 rng(1);
+    std::discrete_distribution<size_t> pick(areas.begin(), areas.end());
+    std::uniform_real_distribution<float> u(0, 1);
+    std::vector<Surface> out;
+    for (size_t tries = 0; out.size() < count && tries < 100 * count; ++tries) {
+        const auto& [mesh, t] = triangles[pick(rng)];
+        const Vec3 a = mesh->positions[t.x], b = mesh->positions[t.y], c = mesh->positions[t.z];
+        float s = u(rng), r = u(rng);
+        if (s + r > 1) s = 1 - s, r = 1 - r;
+        const Vec3 n = glm::normalize(glm::cross(b - a, c - a));
+        if (glm::dot(n, to_light) > 0.2f) out.push_back({a + s * (b - a) + r * (c - a), n});
+    }
+    return out;
+}
+
+double share_agreeing_with_rays(const ShadowDag& dag, const RayTracer& tracer, const std::vector<Surface>& pts,
+                                const PunctualLight& light) {
+    size_t agree = 0;
+    for (const Surface& s : pts) agree += (dag.visibility(s.p, s.n) > 0.5f) == ray_lit(tracer, s.p, s.n, light);
+    return double(agree) / double(pts.size());
+}
+
+}  // namespace
+
+// The villa's closed parts touch and cross everywhere (walls sunk into the ground slab,
+// roofs on walls): lookups of those surfaces land inside the next part, in undefined
+// space that the merge rules fold into lit next to the part's lit side. With undefined
+// space ended a band before such surfaces and stored as shadow, S3 agrees with shadow
+// rays as well as S2 up to one point in a thousand (the Python check's kind of points:
+// random by area, facing the sun). Before, S3 agreed on 95.3 % against S2's 98.9 %.
+TEST(ShadowDag, DoubleDepthAgreesWithShadowRaysAsWellAsThePlainDag) {
+    const Scene villa = make_villa();
+    const SceneFrame frame = villa.evaluate(0);
+    const RayTracer tracer(frame);
+    const PunctualLight& sun = frame.lights.at(0);
+    ASSERT_EQ(sun.type, LightType::Directional);
+    const std::vector<Surface> pts = surface_points_facing(frame, -glm::normalize(sun.direction), 2000);
+    ASSERT_EQ(pts.size(), 2000u);
+    ShadowDagOptions o;
+    o.resolution = 1024;
+    const double s2 = share_agreeing_with_rays(ShadowDag::build(villa, tracer, sun, o), tracer, pts, sun);
+    o.double_depth = true;
+    const ShadowDag s3dag = ShadowDag::build(villa, tracer, sun, o);
+    const double s3 = share_agreeing_with_rays(s3dag, tracer, pts, sun);
+    o.undefined_as = S::Lit;
+    const double s3_lit = share_agreeing_with_rays(ShadowDag::build(villa, tracer, sun, o), tracer, pts, sun);
+    std::printf("agreement with shadow rays: S2 %.4f, S3 %.4f, S3 undefined as lit %.4f\n", s2, s3, s3_lit);
+    EXPECT_GE(s2, 0.97);
+    EXPECT_GE(s3, 0.985);
+    // One point short of S2 remains: a wall face below ground whose lookup moves sideways
+    // into a column of the ground slab that does not meet the wall.
+    EXPECT_GE(s3, s2 - 0.001);
+    EXPECT_GT(s3, s3_lit);  // stored as lit, the folded interiors leak
+}
+
 TEST(ShadowDag, DirectionalLightMatchesShadowRaysUpToOneVoxelOfABoundary) {
     expect_matches_rays(LightType::Directional, true, false);
     expect_matches_rays(LightType::Directional, true, true);
@@ -438,6 +564,64 @@ TEST(ShadowDag, PointLightCubeMatchesShadowRaysUpToOneVoxelOfABoundary) {
     EXPECT_EQ(face.type, LightType::Spot);
     EXPECT_EQ(face.direction, Vec3(0, 0, -1));
     EXPECT_EQ(face.position, light.position);
+}
+
+// Which cube faces of a point light hold a DAG is decided per triangle, not by rays
+// through texel centres: a triangle far smaller than the gap between the 512² rays of
+// the +x face, placed between four of them, still gives that face its DAG (thin geometry
+// such as fire particles would otherwise lose its shadow without a word).
+TEST(ShadowDag, PointLightFaceHoldingOnlyATinyTriangleGetsItsDag) {
+    PunctualLight light;
+    light.name = "point";
+    light.type = LightType::Point;
+    light.position = Vec3(0);
+    const PunctualLight face = LightShadowDags::cube_face(light, 0);  // +x
+    // The directions of four neighbouring rays of a 512² look at the +x face; the
+    // triangle sits where they meet, at axial distance 1, a tenth of their spacing wide.
+    const Bounds3 unit{Vec3(-1), Vec3(1)};
+    const LightSpace probe(face, unit, 512);
+    Vec3 mid(0);
+    for (uint32_t k = 0; k < 4; ++k) {
+        const Vec3 d = probe.texel_ray(255 + (k & 1), 255 + (k >> 1)).direction;
+        mid += d / glm::dot(d, face.direction) / 4.0f;
+    }
+    const float spacing = 2 * std::tan(LightShadowDags::kCubeFaceHalfAngleDegrees * kPi / 180.0f) / 512;
+    const float h = 0.05f * spacing;
+    Scene scene;
+    scene.name = "tiny-triangle";
+    scene.source = "builtin:tiny-triangle";
+    scene.materials.push_back(Material{});
+    Mesh tiny;
+    tiny.positions = {mid + Vec3(0, -h, -h), mid + Vec3(0, h, -h), mid + Vec3(0, 0, h)};
+    tiny.triangles = {{0, 1, 2}};
+    tiny.material_ids = {0};
+    scene.add_mesh_instance(tiny);
+    Mesh ground;  // below the light, in the −y face only
+    ground.positions = {{-0.5f, -1, -0.5f}, {0.5f, -1, -0.5f}, {0.5f, -1, 0.5f}, {-0.5f, -1, 0.5f}};
+    ground.triangles = {{0, 2, 1}, {0, 3, 2}};
+    ground.material_ids = {0, 0};
+    scene.add_mesh_instance(ground);
+    scene.lights.push_back(light);
+    const SceneFrame frame = scene.evaluate(0);
+    const RayTracer tracer(frame);
+    // No ray of the look hits it: the triangle is found by the triangle test alone.
+    for (uint32_t y = 250; y < 262; ++y)
+        for (uint32_t x = 250; x < 262; ++x) {
+            Ray r = probe.texel_ray(x, y);
+            r.origin = light.position;
+            ASSERT_FALSE(tracer.intersect(r).valid()) << x << "," << y;
+        }
+    ShadowDagOptions o;
+    o.resolution = 64;
+    const LightShadowDags dags = LightShadowDags::build(scene, tracer, light, o);
+    EXPECT_TRUE(dags.dag(0).has_value()) << "the +x face holds the tiny triangle";
+    EXPECT_TRUE(dags.dag(3).has_value()) << "the −y face holds the ground";
+    EXPECT_EQ(dags.dag_count(), 2u);
+    // A triangle wholly outside a face's frustum (behind it, or past one side) is not counted.
+    const LightSpace plus_x(face, unit, 64);
+    EXPECT_TRUE(plus_x.may_overlap_triangle(tiny.positions[0], tiny.positions[1], tiny.positions[2]));
+    EXPECT_FALSE(plus_x.may_overlap_triangle(Vec3(-1, 0, 0), Vec3(-1, 0.1f, 0), Vec3(-1, 0, 0.1f)));
+    EXPECT_FALSE(plus_x.may_overlap_triangle(Vec3(1, 2, 0), Vec3(1, 2.1f, 0), Vec3(1, 2, 0.1f)));
 }
 
 TEST(ShadowDag, SpotLightMatchesShadowRaysUpToOneVoxelOfABoundary) {

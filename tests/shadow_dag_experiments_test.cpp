@@ -3,6 +3,7 @@
 // the files are written, every paper column holds the published figure of its row, and
 // the measured figures hold together.
 #include <gtest/gtest.h>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -59,25 +60,41 @@ TEST(ShadowDagExperiments, Table4Storage) {
     // has nothing closed, so S3 = S2 exactly.
     EXPECT_LT((*villa)["S3 / S2"].get<double>(), 0.8);
     EXPECT_DOUBLE_EQ((*terrain)["S3 / S2"].get<double>(), 1.0);
-    EXPECT_DOUBLE_EQ((*terrain)["S3, undefined as shadow (MB)"].get<double>(), (*terrain)["S3 (MB)"].get<double>());
+    EXPECT_DOUBLE_EQ((*terrain)["S3, undefined as lit (MB)"].get<double>(), (*terrain)["S3 (MB)"].get<double>());
 }
 
 TEST(ShadowDagExperiments, Fig15Growth) {
     const ExperimentOutput out = run_quick("dag-fig15");
     const ResultTable& t = out.tables.at(0);
-    bool villa = false;
+    bool villa = false, villa_paper = false;
     for (const json& row : t.rows) {
         const double g2 = row["S2 growth"].get<double>(), g3 = row["S3 growth"].get<double>();
-        // A surface-bound structure grows by about 4 (area) per doubling, not 8 (volume).
-        EXPECT_GT(g2, 1.5) << row.dump();
-        EXPECT_LT(g2, 6.0) << row.dump();
+        // Fig. 15's band per structure: the shadow map stays at 4 (N² texels); the SVDAG
+        // falls from about 3 toward 2, below the shadow map's 4 (a surface-bound
+        // structure, not 8 for a volume); folding closed interiors never makes S3 grow
+        // faster than S2 (the same on the open terrain).
+        EXPECT_EQ(row["S1 growth"].get<double>(), 4.0) << row.dump();
+        EXPECT_GE(g2, 2.0) << row.dump();
+        EXPECT_LT(g2, 4.0) << row.dump();
         EXPECT_GT(g3, 1.0) << row.dump();
+        EXPECT_LE(g3, g2 * (1 + 1e-12)) << row.dump();
+        if (row["scene"] == "fbm_terrain") {
+            EXPECT_DOUBLE_EQ(g3, g2) << row.dump();
+        }
         if (row["scene"] == "villa" && row["N → 2N"] == "500 → 1000") {
             villa = true;
             EXPECT_TRUE(row["paper S2 growth"].is_null());  // the paper's doublings start at 1000
         }
+        if (row["scene"] == "villa" && row["N → 2N"] == "1000 → 2000") {
+            // Villa in P2 Table 4: S2 0.462 → 2.47 MB, S3 0.146 → 0.336 MB.
+            villa_paper = true;
+            EXPECT_DOUBLE_EQ(row["paper S1 growth"].get<double>(), 9.27 / 2.30);
+            EXPECT_DOUBLE_EQ(row["paper S2 growth"].get<double>(), 2.47 / 0.462);
+            EXPECT_DOUBLE_EQ(row["paper S3 growth"].get<double>(), 0.336 / 0.146);
+        }
     }
     EXPECT_TRUE(villa);
+    EXPECT_TRUE(villa_paper);
     ASSERT_EQ(out.plots.size(), 2u);  // S2 and S3
 }
 
@@ -94,7 +111,16 @@ TEST(ShadowDagExperiments, Fig16To18ShadowTimes) {
         if (row["visibility"] == "ray") {
             EXPECT_EQ(differ, 0);
         }
-        EXPECT_TRUE(row["paper vs shadow map (%)"].is_null());  // the paper's figure is for Citadel only
+        EXPECT_TRUE(row["paper mean vs shadow map (%)"].is_null());  // the paper's figure is for Citadel only
+        // Median and mean recomputed from the per-frame table.
+        std::vector<double> frame_ms;
+        for (const json& f : out.tables.at(1).rows)
+            if (f["scene"] == "villa") frame_ms.push_back(f[row["visibility"].get<std::string>() + " (ms)"].get<double>());
+        ASSERT_EQ(frame_ms.size(), 3u);
+        std::sort(frame_ms.begin(), frame_ms.end());
+        EXPECT_DOUBLE_EQ(row["shadow time per frame (ms)"].get<double>(), frame_ms[1]);
+        EXPECT_NEAR(row["mean shadow time per frame (ms)"].get<double>(),
+                    (frame_ms[0] + frame_ms[1] + frame_ms[2]) / 3, 1e-9 * frame_ms[2]);
     }
     EXPECT_EQ(villa_rows, 4);
     EXPECT_EQ(out.tables.at(1).rows.size() % 3, 0u);  // 3 frames per scene

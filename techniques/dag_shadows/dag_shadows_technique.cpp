@@ -65,7 +65,7 @@ DagShadowsSettings DagShadowsSettings::from(const Settings& s) {
     if (tile < 0 || tile > int64_t(kMaxLightSpaceResolution) || (tile & (tile - 1)))
         throw Error(std::string(kName) + ".tile", "must be 0 (automatic) or a power of two");
     o.tile = uint32_t(tile);
-    const std::string undefined = s.get<std::string>("undefined_as", "lit");
+    const std::string undefined = s.get<std::string>("undefined_as", "shadow");
     if (undefined != "lit" && undefined != "shadow")
         throw Error(std::string(kName) + ".undefined_as", "must be lit or shadow, not '" + undefined + "'");
     o.undefined_as = undefined == "lit" ? ShadowState::Lit : ShadowState::Shadow;

@@ -9,8 +9,8 @@
 // resolution (1024: light-space voxels per axis), light (index of the shadow light
 // among the scene's punctual lights; default the first directional or spot light),
 // pcf (1: k×k percentage-closer filtering), shadow_map_bits (32 or 16), tile (0: the
-// DAG build's x–y tile side, 0 = automatic), undefined_as (lit: how undefined space
-// left inside boundary nodes is stored, lit or shadow), ambient (0.03: unshadowed ambient
+// DAG build's x–y tile side, 0 = automatic), undefined_as (shadow: how undefined space
+// left inside boundary nodes is stored and what lookups there answer, shadow or lit), ambient (0.03: unshadowed ambient
 // irradiance as a fraction of the light's, so shadowed surfaces stay visible),
 // tile_size (16: image tile), seed (recorded only: nothing is random).
 // Layers: color (emission + diffuse reflection of the light and the ambient term),
@@ -35,7 +35,7 @@ struct DagShadowsSettings {
     int pcf = 1;
     int shadow_map_bits = 32;
     uint32_t tile = 0;
-    ShadowState undefined_as = ShadowState::Lit;
+    ShadowState undefined_as = ShadowState::Shadow;
     float ambient = 0.03f;
     int tile_size = 16;
     uint64_t seed = 1;  // accepted and recorded; the technique draws no random numbers

@@ -126,8 +126,9 @@ def test_from_depth_maps_follows_the_depth_rule():
 def test_shadow_query_agrees_with_ray_traced_shadows(villa):
     """visibility() against shadow rays cast in NumPy toward the same sun, on 1200 random
     surface points facing it (n·L > 0.2). Depth quantization and the lookup bias disagree
-    only near shadow edges: S2 at 1024³ agrees on ≥ 97 % of points, S3 on ≥ 93 % (its
-    lookups near contacts between closed parts can fall inside a part, stored as lit)."""
+    only near shadow edges: S2 at 1024³ agrees on ≥ 97 % of points, and S3 at least as
+    well (≥ 99 % here): lookups of surfaces touching or inside a closed part land in its
+    undefined interior, which ends a band before such surfaces and is stored as shadow."""
     positions, triangles = villa.evaluate(0).merged()
     p = positions.astype(np.float64)
     a, b, c = p[triangles[:, 0]], p[triangles[:, 1]], p[triangles[:, 2]]
@@ -170,9 +171,11 @@ def test_shadow_query_agrees_with_ray_traced_shadows(villa):
     pts, nrm = points.astype(np.float32), normals.astype(np.float32)
     vis = s2.visibility(pts, nrm)
     assert vis.dtype == np.float32 and vis.shape == (1200,) and set(np.unique(vis)) <= {0.0, 1.0}
-    assert ((vis > 0.5) == reference).mean() >= 0.97
+    s2_agree = ((vis > 0.5) == reference).mean()
+    assert s2_agree >= 0.97
     s3 = gilab.ShadowDag.build(villa, resolution=1024, double_depth=True)
-    assert ((s3.visibility(pts, nrm) > 0.5) == reference).mean() >= 0.93
+    s3_agree = ((s3.visibility(pts, nrm) > 0.5) == reference).mean()
+    assert s3_agree >= 0.99 and s3_agree >= s2_agree
 
     # One point → float; surfaces turned away are unlit; PCF gives fractions.
     assert s2.visibility(pts[0], nrm[0]) == vis[0]
@@ -310,8 +313,8 @@ def test_shadow_dag_matches_dag_table4(name, quick_tables):
         assert (s2.node_count, s3.node_count) == (row["S2 nodes"], row["S3 nodes"])
         assert (s2.bytes / 1e6, s3.bytes / 1e6) == (row["S2 (MB)"], row["S3 (MB)"])
         if name == "villa":  # the other storage of undefined space (cheap here)
-            s3_shadow = gilab.ShadowDag.build(scene, resolution=row["N"], double_depth=True, undefined_as="shadow")
-            assert s3_shadow.bytes / 1e6 == row["S3, undefined as shadow (MB)"]
+            s3_lit = gilab.ShadowDag.build(scene, resolution=row["N"], double_depth=True, undefined_as="lit")
+            assert s3_lit.bytes / 1e6 == row["S3, undefined as lit (MB)"]
 
 
 @pytest.mark.parametrize("name", TABLE5_SCENES)
