@@ -21,7 +21,6 @@
 #include <tiny_gltf.h>
 
 #include <cstring>
-#include <functional>
 #include <map>
 #include <set>
 #include <sstream>
@@ -657,10 +656,23 @@ Scene load_gltf(const fs::path& path) {
             if (!is_child[i]) roots.push_back(int(i));
     }
 
-    // Depth-first, so parents precede children; rest-pose world matrices on the way.
+    // Depth-first, so parents precede children; rest-pose world matrices on the way. An
+    // explicit stack, not recursion: a valid hierarchy may be thousands of levels deep.
     std::vector<int> gltf_to_node(model.nodes.size(), -1);
     std::vector<Mat4> gltf_world(model.nodes.size(), Mat4(1.0f));
-    std::function<void(int, int, const Mat4&)> visit = [&](int gi, int parent, const Mat4& parent_world) {
+    struct PendingNode {
+        int gltf_index;
+        int parent;         // scene node index, -1 for a root
+        int parent_gltf;    // glTF node index of the parent, -1 for a root
+    };
+    std::vector<PendingNode> pending;
+    auto push_in_order = [&](const std::vector<int>& gltf_nodes, int parent, int parent_gltf) {
+        for (auto it = gltf_nodes.rbegin(); it != gltf_nodes.rend(); ++it) pending.push_back({*it, parent, parent_gltf});
+    };
+    push_in_order(roots, -1, -1);
+    while (!pending.empty()) {
+        const auto [gi, parent, parent_gltf] = pending.back();
+        pending.pop_back();
         if (gi < 0 || size_t(gi) >= model.nodes.size())
             throw Error(file, "node " + std::to_string(gi) + " is out of range (the file has " +
                                   std::to_string(model.nodes.size()) + " nodes)");
@@ -678,11 +690,11 @@ Scene load_gltf(const fs::path& path) {
                                   "'): its matrix does not decompose into a finite translation, rotation and scale");
         const int index = int(scene.nodes.size());
         gltf_to_node[size_t(gi)] = index;
+        const Mat4 parent_world = parent_gltf >= 0 ? gltf_world[size_t(parent_gltf)] : Mat4(1.0f);
         gltf_world[size_t(gi)] = parent_world * node_local_matrix(gn);
         scene.nodes.push_back(std::move(node));
-        for (int child : gn.children) visit(child, index, gltf_world[size_t(gi)]);
-    };
-    for (int r : roots) visit(r, -1, Mat4(1.0f));
+        push_in_order(gn.children, index, gi);
+    }
 
     // Skins, converted once when a displayed node first uses them.
     std::vector<int> skin_slots(model.skins.size(), -1);

@@ -184,3 +184,31 @@ TEST_F(CliBadInput, FlatModelWithoutCameraIsSeen) {
     for (float v : film.layer("color").data) brightest = std::max(brightest, v);
     EXPECT_GT(brightest, 0.0f) << "the default camera's image is black";
 }
+
+TEST_F(CliBadInput, DeepNodeHierarchyRenders) {
+    // 20000 nested nodes above one triangle: a stack overflow (SIGSEGV) when the
+    // hierarchy was walked recursively.
+    constexpr int kDepth = 20000;
+    std::string nodes;
+    for (int i = 0; i < kDepth; ++i) {
+        if (i > 0) nodes += ',';
+        if (i + 1 < kDepth) {
+            nodes += R"({"children":[)";
+            nodes += std::to_string(i + 1);
+            nodes += "]}";
+        } else {
+            nodes += R"({"mesh":0})";
+        }
+    }
+    const std::string triangle = R"("buffers":[{"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA","byteLength":36}],
+        "bufferViews":[{"buffer":0,"byteLength":36}],
+        "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
+        "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}])";
+    const fs::path chain = gilab::test::write_file(dir_, "chain.gltf",
+                                                   R"({"asset":{"version":"2.0"},)" + triangle + R"(,"nodes":[)" + nodes +
+                                                       R"(],"scenes":[{"nodes":[0]}],"scene":0})");
+    const GilabRun r = run_gilab(render({}, chain.string()));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_TRUE(fs::exists(out_ / "image.exr"));
+    EXPECT_LT(r.peak_rss_kb, kMaxPeakKb);
+}

@@ -7,6 +7,7 @@
 
 #include <cstring>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include "core/error.hpp"
 #include "core/mesh_loaders.hpp"
 #include "core/scene_file.hpp"
@@ -598,4 +599,68 @@ TEST(RealGlb, CesiumManTextureTintsAlbedo) {
     // The base colour factor is white; the texture's mean colour must pull it below 1.
     EXPECT_LT(max_component(s.materials[0].albedo), 0.9f);
     EXPECT_GT(max_component(s.materials[0].albedo), 0.0f);
+}
+
+// ---------------------------------------------------------------- deep node hierarchies
+
+namespace {
+
+// tests/data/bad/base/triangle.gltf as JSON, to build variants of.
+nlohmann::json triangle_gltf() {
+    std::ifstream in(fs::path(GILAB_SOURCE_DIR) / "tests" / "data" / "bad" / "base" / "triangle.gltf");
+    return nlohmann::json::parse(in);
+}
+
+// The triangle under a chain of `depth` nodes, each the only child of the one before,
+// every node built from `node_template` (its transform).
+nlohmann::json node_chain(size_t depth, const nlohmann::json& node_template) {
+    nlohmann::json doc = triangle_gltf();
+    doc["nodes"] = nlohmann::json::array();
+    for (size_t i = 0; i < depth; ++i) {
+        nlohmann::json node = node_template;
+        if (i + 1 < depth) node["children"] = {i + 1};
+        else node["mesh"] = 0;
+        doc["nodes"].push_back(node);
+    }
+    doc["scenes"] = {{{"nodes", {0}}}};
+    return doc;
+}
+
+}  // namespace
+
+TEST(GltfDeepHierarchy, ChainsThousandsOfNodesDeepLoad) {
+    // The hierarchy was walked recursively: 20000 levels overflowed the stack (SIGSEGV).
+    const fs::path dir = test::temp_dir("gltf_deep_chain");
+    for (size_t depth : {size_t(5000), size_t(50000)}) {
+        const std::string name = "chain" + std::to_string(depth) + ".gltf";
+        const Scene s = load_gltf(write_file(dir, name, node_chain(depth, {{"translation", {0.0, 0.0, 0.0}}}).dump()));
+        ASSERT_EQ(s.nodes.size(), depth);
+        for (size_t i = 1; i < s.nodes.size(); ++i) ASSERT_EQ(s.nodes[i].parent, int(i - 1));
+        EXPECT_EQ(s.nodes.back().meshes.size(), 1u);
+        EXPECT_EQ(s.triangle_count(), 1u);
+    }
+}
+
+TEST(GltfDeepHierarchy, IdentityChainOfHundredNodesLoads) {
+    // Each node's rotation was bounded by √3 and the bounds multiplied: 100 identity
+    // nodes were refused as reaching "coordinates of about 1.35e+18".
+    const nlohmann::json identity = {{"translation", {0.0, 0.0, 0.0}}, {"rotation", {0.0, 0.0, 0.0, 1.0}}, {"scale", {1.0, 1.0, 1.0}}};
+    const fs::path dir = test::temp_dir("gltf_identity_chain");
+    const Scene s = load_gltf(write_file(dir, "identity.gltf", node_chain(100, identity).dump()));
+    EXPECT_EQ(s.nodes.size(), 100u);
+    const SceneFrame frame = s.evaluate(0.0);
+    EXPECT_NEAR(frame.bounds.max.x, 1.0f, 1e-5f);
+    // A quarter turn per node composes to whole turns, not to a product of bounds.
+    const double s2 = std::sqrt(0.5);
+    const nlohmann::json quarter_turn = {{"rotation", {0.0, 0.0, s2, s2}}};
+    EXPECT_NO_THROW(load_gltf(write_file(dir, "turns.gltf", node_chain(100, quarter_turn).dump())));
+}
+
+TEST(GltfDeepHierarchy, ComposedTransformBeyondTheRangeIsStillRefused) {
+    // Scale 100 at each of 10 levels: 1e20, beyond ±1e18, though each node is modest.
+    const fs::path path = write_file(test::temp_dir("gltf_composed_overflow"), "far.gltf",
+                                     node_chain(10, {{"scale", {100.0, 100.0, 100.0}}}).dump());
+    const std::string msg = error_of([&] { load_gltf(path); });
+    EXPECT_NE(msg.find("far.gltf"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("beyond the supported range"), std::string::npos) << msg;
 }
