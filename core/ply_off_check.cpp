@@ -181,6 +181,7 @@ private:
     std::vector<Element> elements_;
     size_t data_ = 0;  // first byte after the header
     PolygonFileCounts counts_;
+    size_t free_text_lines_ = 0;
 
     std::string at_line(size_t line) const { return file_ + ":" + std::to_string(line); }
     std::string at_byte(size_t offset) const { return file_ + " (byte " + std::to_string(offset) + ")"; }
@@ -256,10 +257,22 @@ private:
                 }
                 elements_.back().properties.push_back(p);
             } else {
-                throw Error(where, "malformed PLY header: unknown keyword " + quote(t[0]));
+                note_free_text(where, t[0]);
             }
         }
         throw Error(file_, malformed);
+    }
+
+    // Free text in the header: one note per line for the first few, then a count (a
+    // header of a million such lines must not make a million warnings).
+    void note_free_text(const std::string& where, std::string_view first_word) {
+        constexpr size_t kNotedLines = 5;
+        ++free_text_lines_;
+        if (free_text_lines_ <= kNotedLines)
+            counts_.warnings.push_back(where + ": header line starting with " + quote(first_word) +
+                                       " is not a PLY keyword; ignored");
+        else if (free_text_lines_ == kNotedLines + 1)
+            counts_.warnings.push_back(file_ + ": further header lines that are no PLY keyword ignored");
     }
 
     // Each element's count against the bytes after the header and the budget, before
