@@ -156,12 +156,13 @@ struct SceneBuilder {
     }
 
     fs::path resolve(const std::string& name, const std::string& ptr) {
-        if (auto found = assets.find(name)) return *found;
-        std::error_code ec;
-        const fs::path local = json_dir / name;
-        if (fs::is_regular_file(local, ec)) return local;
-        if (fs::is_directory(local, ec) || fs::is_directory(name, ec))
-            in.fail(ptr, "'" + name + "' is a directory, not a mesh file");
+        try {
+            if (auto found = assets.find(name)) return *found;
+            const fs::path local = json_dir / name;
+            if (regular_file_exists(local)) return local;
+        } catch (const Error& e) {  // a device, FIFO or directory by that name
+            in.fail(ptr, "'" + name + "': " + e.what());
+        }
         std::string searched = "the working directory";
         if (!assets.dirs().empty()) searched += ", " + assets.describe();
         searched += ", " + (json_dir.empty() ? std::string(".") : json_dir.string());

@@ -4,6 +4,7 @@
 // and no file left in the output directory.
 #include <gtest/gtest.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -211,4 +212,18 @@ TEST_F(CliBadInput, DeepNodeHierarchyRenders) {
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_TRUE(fs::exists(out_ / "image.exr"));
     EXPECT_LT(r.peak_rss_kb, kMaxPeakKb);
+}
+
+TEST_F(CliBadInput, ReferencedFilesThatAreNotFilesAreRefusedAtOnce) {
+    // An MTL pointing to /dev/zero read for 95 s and reached 15 GB; a FIFO blocks on open.
+    fs::create_symlink("/dev/zero", dir_ / "zero.mtl");
+    ASSERT_EQ(mkfifo((dir_ / "fifo.mtl").c_str(), 0600), 0);
+    const std::string triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    const fs::path zero = gilab::test::write_file(dir_, "zero.obj", "mtllib zero.mtl\n" + triangle);
+    const fs::path fifo = gilab::test::write_file(dir_, "fifo.obj", "mtllib fifo.mtl\n" + triangle);
+    expect_error(render({}, zero.string()), {"zero.obj", "zero.mtl", "is a character device, not a regular file"}, out_);
+    expect_error(render({}, fifo.string()), {"fifo.obj", "fifo.mtl", "is a FIFO (named pipe), not a regular file"}, out_);
+    fs::create_symlink("/dev/zero", dir_ / "part.obj");
+    const fs::path scene = gilab::test::write_file(dir_, "scene.json", R"({"meshes": [{"file": "part.obj"}]})");
+    expect_error(render({}, scene.string()), {"scene.json", "/meshes/0/file", "part.obj", "not a regular file"}, out_);
 }

@@ -5,8 +5,10 @@
 // Truncations of valid files at several offsets and the memory budget are checked too.
 #include <gtest/gtest.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include "core/error.hpp"
 #include "core/memory_budget.hpp"
@@ -153,9 +155,9 @@ const BadCase kCases[] = {
     {"obj_utf16.obj", {"UTF-16", "not supported"}},
     {"scene_utf16.json", {"UTF-16", "not supported"}},
     // Paths that are not mesh files.
-    {"directory.obj", {"is a directory, not a file"}},
-    {"gltf_buffer_uri_dot.gltf", {"/buffers/0/uri", "'.'", "is a directory"}},
-    {"scene_directory_mesh.json", {"/meshes/0/file", "'directory.obj' is a directory"}},
+    {"directory.obj", {"is a directory, not a regular file"}},
+    {"gltf_buffer_uri_dot.gltf", {"/buffers/0/uri", "'.'", "is a directory, not a regular file"}},
+    {"scene_directory_mesh.json", {"/meshes/0/file", "'directory.obj'", "is a directory, not a regular file"}},
     {"scene_missing_mesh.json", {"/meshes/0/file", "'base/no_such_mesh.obj' not found"}},
 };
 
@@ -226,6 +228,77 @@ TEST(BadInputTruncation, ValidFilesCutAtSeveralOffsets) {
         }
     }
 }
+
+// ---------------------------------------------------------------- files that are not files
+
+// Puts something that is not a regular file at `at`: /dev/zero (reads without end), a
+// FIFO (blocks on open until a writer comes) or a directory.
+void make_non_regular(const fs::path& at, const std::string& kind) {
+    if (kind == "device") fs::create_symlink("/dev/zero", at);
+    else if (kind == "fifo") ASSERT_EQ(mkfifo(at.c_str(), 0600), 0) << at;
+    else fs::create_directory(at);
+}
+
+// Loading `path`, which references `referenced`, fails at once naming both, with the
+// words "not a regular file" (not "not found"), without allocating much.
+void expect_refused(const fs::path& path, const std::string& referenced) {
+    const long before = peak_rss_kb();
+    const std::string message = error_loading(path);
+    EXPECT_NE(message.find(path.filename().string()), std::string::npos) << message;
+    EXPECT_NE(message.find(referenced), std::string::npos) << message;
+    EXPECT_NE(message.find("not a regular file"), std::string::npos) << message;
+    EXPECT_EQ(message.find("not found"), std::string::npos) << message;
+    EXPECT_LT(peak_rss_kb() - before, kMaxGrowthKb) << path;
+}
+
+std::string triangle_gltf_with(const std::function<void(nlohmann::json&)>& change) {
+    std::ifstream in(bad_dir() / "base" / "triangle.gltf");
+    nlohmann::json doc = nlohmann::json::parse(in);
+    change(doc);
+    return doc.dump();
+}
+
+class NonRegularFile : public ::testing::TestWithParam<std::string> {
+protected:
+    fs::path dir() const { return test::temp_dir("non_regular_" + GetParam()); }
+};
+
+TEST_P(NonRegularFile, AsMaterialLibrary) {
+    // An MTL that was /dev/zero read for 95 s and reached 15 GB.
+    const fs::path d = dir();
+    make_non_regular(d / "lib.mtl", GetParam());
+    expect_refused(test::write_file(d, "mesh.obj", "mtllib lib.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), "lib.mtl");
+}
+
+TEST_P(NonRegularFile, AsGltfBuffer) {
+    const fs::path d = dir();
+    make_non_regular(d / "data.bin", GetParam());
+    expect_refused(test::write_file(d, "buffer.gltf", triangle_gltf_with([](nlohmann::json& doc) {
+                                        doc["buffers"][0]["uri"] = "data.bin";
+                                    })),
+                   "data.bin");
+}
+
+TEST_P(NonRegularFile, AsGltfImage) {
+    const fs::path d = dir();
+    make_non_regular(d / "texture.png", GetParam());
+    expect_refused(test::write_file(d, "image.gltf", triangle_gltf_with([](nlohmann::json& doc) {
+                                        doc["images"] = {{{"uri", "texture.png"}}};
+                                        doc["textures"] = {{{"source", 0}}};
+                                        doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
+                                        doc["meshes"][0]["primitives"][0]["material"] = 0;
+                                    })),
+                   "texture.png");
+}
+
+TEST_P(NonRegularFile, AsSceneFileMesh) {
+    const fs::path d = dir();
+    make_non_regular(d / "part.obj", GetParam());
+    expect_refused(test::write_file(d, "scene.json", R"({"meshes": [{"file": "part.obj"}]})"), "part.obj");
+}
+
+INSTANTIATE_TEST_SUITE_P(Kinds, NonRegularFile, ::testing::Values("device", "fifo", "directory"),
+                         [](const auto& info) { return info.param; });
 
 // ---------------------------------------------------------------- memory budget
 
