@@ -160,6 +160,7 @@ TEST_F(CliBadInput, GlobalOptionsAreChecked) {
     EXPECT_FALSE(contains(threads.output, "1797693")) << "prints the largest double as a bound: " << threads.output;
     const GilabRun help = run_gilab({"--help"});
     EXPECT_TRUE(contains(help.output, "--memory-limit")) << help.output;
+    EXPECT_TRUE(contains(help.output, "each request on its own")) << "--help must say how the limit applies: " << help.output;
 }
 
 TEST_F(CliBadInput, UnicodePathIsNamedInTheError) {

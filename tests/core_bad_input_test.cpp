@@ -346,6 +346,16 @@ TEST(MemoryBudget, ChecksNameWhatAndWhere) {
     EXPECT_EQ(MemoryBudget::times(uint64_t(1) << 40, uint64_t(1) << 40), UINT64_MAX);  // saturates
 }
 
+TEST(MemoryBudget, AppliesToEachRequestOnItsOwn) {
+    // The documented rule (README, --help): no running total, so requests that each fit
+    // pass however many there are, and one that does not fit is refused alone.
+    ScopedMemoryLimit limit(1000);
+    for (int i = 0; i < 3; ++i) EXPECT_NO_THROW(MemoryBudget::check(600, "a 600-byte request", "test"));
+    EXPECT_NE(test::error_of([] { MemoryBudget::check(1001, "a 1001-byte request", "test"); }).find("memory limit of 1000"),
+              std::string::npos);
+    for (int i = 0; i < 3; ++i) EXPECT_NO_THROW(load_any(bad_dir() / "base" / "tri.obj"));
+}
+
 TEST(MemoryBudget, LoadersRefuseFilesBeyondTheBudget) {
     ScopedMemoryLimit limit(512);
     for (const char* name : {"pyramid.ply", "pyramid.off", "triangle.gltf", "triangle.glb"}) {
