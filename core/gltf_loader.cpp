@@ -25,6 +25,7 @@
 #include <set>
 #include <sstream>
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "core/gltf_checks.hpp"
 #include "core/input_file.hpp"
 #include "core/memory_budget.hpp"
@@ -217,12 +218,9 @@ void check_node_transform(const std::string& file, int index, const tinygltf::No
     for (const auto& [name, values] : parts)
         for (size_t k = 0; k < values->size(); ++k) {
             const double v = (*values)[k];
-            if (!std::isfinite(v) || std::abs(v) > double(std::numeric_limits<float>::max())) {
-                std::ostringstream text;
-                text << v;
+            if (!std::isfinite(v) || std::abs(v) > double(std::numeric_limits<float>::max()))
                 throw Error(file, "/nodes/" + std::to_string(index) + "/" + name + "/" + std::to_string(k) + ": " +
-                                      text.str() + " is out of range (single precision holds at most ±3.4e38)");
-            }
+                                      number_as_given(v) + " is out of range (single precision holds at most ±3.4e38)");
         }
 }
 

@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "core/memory_budget.hpp"
 
 namespace gilab {
@@ -37,12 +38,11 @@ std::vector<std::string_view> split(std::string_view line) {
     return tokens;
 }
 
-// An index or count read as a double, printed as an integer when it is one.
+// An index or count read as a double, printed as an integer when it is one and as
+// read otherwise.
 std::string number_text(double v) {
     if (v == std::floor(v) && std::abs(v) < 1e18) return std::to_string(int64_t(v));
-    char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%g", v);
-    return buffer;
+    return number_as_given(v);
 }
 
 std::string quote(std::string_view t) {

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <string>
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "core/skin.hpp"
 
 namespace gilab {
@@ -138,7 +139,7 @@ SceneFrame flatten(const Scene& scene, const std::vector<Mat4>& world, double ti
             if (!finite)
                 throw Error(scene.source.empty() ? scene.name : scene.source,
                             "node " + std::to_string(i) + " ('" + node.name + "') puts mesh '" + mesh.name +
-                                "' at non-finite world positions at t = " + std::to_string(time) +
+                                "' at non-finite world positions at t = " + number_as_given(time) +
                                 " s (its transform overflows)");
             wm.material_ids = mesh.material_ids;
             frame.meshes.push_back(std::move(wm));
@@ -258,7 +259,7 @@ void Scene::validate() const {
                                        " but the scene has " + std::to_string(meshes.size()));
     if (meshes.empty() || triangle_count() == 0) throw Error(where, "scene has no triangles (empty scene)");
     if (!(std::isfinite(frames_per_second) && frames_per_second > 0))
-        throw Error(where, "frames per second " + approx(frames_per_second) + " must be a positive number");
+        throw Error(where, "frames per second " + number_as_given(frames_per_second) + " must be a positive number");
     if (is_animated()) {
         const double frames = std::floor(animation_duration() * frames_per_second + 1e-6) + 1;
         if (!(frames <= kMaxAnimationFrames))
