@@ -228,3 +228,22 @@ TEST_F(CliBadInput, ReferencedFilesThatAreNotFilesAreRefusedAtOnce) {
     const fs::path scene = gilab::test::write_file(dir_, "scene.json", R"({"meshes": [{"file": "part.obj"}]})");
     expect_error(render({}, scene.string()), {"scene.json", "/meshes/0/file", "part.obj", "not a regular file"}, out_);
 }
+
+TEST_F(CliBadInput, ZeroScaleAndNegativeLightAreErrorsNotImages) {
+    // Both rendered and exited 0: an all-black image, and one with negative pixels.
+    const std::string triangle = R"({"asset":{"version":"2.0"},
+        "buffers":[{"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA","byteLength":36}],
+        "bufferViews":[{"buffer":0,"byteLength":36}],
+        "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
+        "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)";
+    const fs::path zero = gilab::test::write_file(
+        dir_, "zero_scale.gltf", triangle + R"("nodes":[{"mesh":0,"scale":[0,0,0]}],"scenes":[{"nodes":[0]}]})");
+    expect_error(render({}, zero.string()), {"zero_scale.gltf", "nothing visible"}, out_);
+    const fs::path light = gilab::test::write_file(
+        dir_, "negative_light.gltf",
+        triangle + R"("extensionsUsed":["KHR_lights_punctual"],
+        "extensions":{"KHR_lights_punctual":{"lights":[{"type":"point","name":"lamp","color":[1,-2,1]}]}},
+        "nodes":[{"mesh":0},{"translation":[0,0,2],"extensions":{"KHR_lights_punctual":{"light":0}}}],
+        "scenes":[{"nodes":[0,1]}]})");
+    expect_error(render({}, light.string()), {"negative_light.gltf", "light 'lamp'", "color/1", "-2"}, out_);
+}

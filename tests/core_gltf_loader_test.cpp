@@ -664,3 +664,102 @@ TEST(GltfDeepHierarchy, ComposedTransformBeyondTheRangeIsStillRefused) {
     EXPECT_NE(msg.find("far.gltf"), std::string::npos) << msg;
     EXPECT_NE(msg.find("beyond the supported range"), std::string::npos) << msg;
 }
+
+// ---------------------------------------------------------------- extension and camera numbers
+
+namespace {
+
+// The triangle plus a node carrying a KHR_lights_punctual light.
+nlohmann::json with_light(const nlohmann::json& light) {
+    nlohmann::json doc = triangle_gltf();
+    doc["extensionsUsed"] = {"KHR_lights_punctual"};
+    doc["extensions"]["KHR_lights_punctual"]["lights"] = {light};
+    doc["nodes"].push_back({{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+    doc["scenes"][0]["nodes"] = {0, 1};
+    return doc;
+}
+
+// The triangle plus a node carrying a perspective camera.
+nlohmann::json with_camera(const nlohmann::json& perspective) {
+    nlohmann::json doc = triangle_gltf();
+    doc["cameras"] = {{{"type", "perspective"}, {"name", "view"}, {"perspective", perspective}}};
+    doc["nodes"].push_back({{"camera", 0}, {"translation", {0.0, 0.0, 5.0}}});
+    doc["scenes"][0]["nodes"] = {0, 1};
+    return doc;
+}
+
+struct NumberCase {
+    const char* name;
+    nlohmann::json doc;
+    std::vector<std::string> expected;  // substrings of the error
+};
+
+}  // namespace
+
+TEST(GltfNumbers, LightAndCameraValuesAreCheckedLikeTheSceneFile) {
+    // Each was accepted: a negative colour rendered negative pixels, a degenerate camera
+    // was dropped silently for the default view.
+    const nlohmann::json point = {{"type", "point"}, {"name", "lamp"}};
+    auto light = [&](nlohmann::json changes) {
+        nlohmann::json l = point;
+        l.update(changes);
+        return with_light(l);
+    };
+    const NumberCase cases[] = {
+        {"negative_colour", light({{"color", {-1.0, 1.0, 1.0}}}), {"/extensions/KHR_lights_punctual/lights/0/color/0", "light 'lamp'", "-1"}},
+        {"huge_colour", light({{"color", {1.0, 1e39, 1.0}}}), {"lights/0/color/1", "light 'lamp'", "1e+39"}},
+        {"negative_intensity", light({{"intensity", -5.0}}), {"lights/0/intensity", "light 'lamp'", "-5"}},
+        {"outer_cone_beyond_90_degrees", light({{"type", "spot"}, {"spot", {{"outerConeAngle", 2.0}}}}),
+         {"lights/0/spot/outerConeAngle", "light 'lamp'", "2 is out of range"}},
+        {"inner_cone_equal_to_outer", light({{"type", "spot"}, {"spot", {{"innerConeAngle", 0.5}, {"outerConeAngle", 0.5}}}}),
+         {"lights/0/spot/innerConeAngle", "0.5 is out of range"}},
+        {"negative_inner_cone", light({{"type", "spot"}, {"spot", {{"innerConeAngle", -0.1}}}}), {"spot/innerConeAngle", "-0.1"}},
+        {"yfov_zero", with_camera({{"yfov", 0.0}, {"znear", 0.1}}), {"/cameras/0/perspective/yfov", "camera 0 'view'", "0 is out of range"}},
+        {"yfov_beyond_pi", with_camera({{"yfov", 4.0}, {"znear", 0.1}}), {"perspective/yfov", "4 is out of range"}},
+        {"znear_negative", with_camera({{"yfov", 0.8}, {"znear", -0.1}}), {"perspective/znear", "-0.1"}},
+        {"zfar_before_znear", with_camera({{"yfov", 0.8}, {"znear", 0.1}, {"zfar", 0.05}}), {"perspective/zfar", "0.05", "znear = 0.1"}},
+        {"aspect_ratio_negative", with_camera({{"yfov", 0.8}, {"znear", 0.1}, {"aspectRatio", -1.5}}), {"perspective/aspectRatio", "-1.5"}},
+    };
+    const fs::path dir = test::temp_dir("gltf_numbers");
+    for (const NumberCase& c : cases) {
+        const std::string file = std::string(c.name) + ".gltf";
+        const fs::path path = write_file(dir, file, c.doc.dump());
+        const std::string msg = error_of([&] { load_gltf(path); });
+        EXPECT_NE(msg.find(file), std::string::npos) << c.name << ": " << msg;
+        for (const std::string& part : c.expected) EXPECT_NE(msg.find(part), std::string::npos) << c.name << ": missing '" << part << "' in: " << msg;
+    }
+}
+
+TEST(GltfNumbers, ValidLightsAndCamerasLoad) {
+    const fs::path dir = test::temp_dir("gltf_numbers_valid");
+    const Scene spot = load_gltf(write_file(dir, "spot.gltf",
+                                            with_light({{"type", "spot"}, {"color", {1.0, 0.5, 0.0}}, {"intensity", 0.0},
+                                                        {"spot", {{"innerConeAngle", 0.0}, {"outerConeAngle", kPi / 2}}}})
+                                                .dump()));
+    ASSERT_EQ(spot.lights.size(), 1u);
+    EXPECT_EQ(spot.lights[0].intensity, Vec3(0.0f));
+    const Scene cam = load_gltf(write_file(dir, "camera.gltf",
+                                           with_camera({{"yfov", 0.8}, {"znear", 0.1}, {"zfar", 100.0}, {"aspectRatio", 1.5}}).dump()));
+    ASSERT_TRUE(cam.camera.has_value());
+    EXPECT_NEAR(cam.camera->vertical_fov_degrees, glm::degrees(0.8f), 1e-4f);
+    const Scene infinite = load_gltf(write_file(dir, "infinite.gltf", with_camera({{"yfov", 0.8}, {"znear", 0.1}}).dump()));
+    EXPECT_TRUE(infinite.camera.has_value());
+}
+
+TEST(GltfNumbers, ZeroScaleThatLeavesNothingVisibleIsAnError) {
+    // Rendered an all-black image with exit status 0.
+    const fs::path dir = test::temp_dir("gltf_zero_scale");
+    nlohmann::json doc = triangle_gltf();
+    doc["nodes"][0]["name"] = "model";
+    doc["nodes"][0]["scale"] = {0.0, 0.0, 0.0};
+    const std::string msg = error_of([&] { load_gltf(write_file(dir, "zero.gltf", doc.dump())); });
+    EXPECT_NE(msg.find("zero.gltf"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("nothing visible"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("node 'model' has scale [0, 0, 0]"), std::string::npos) << msg;
+    // The triangle lies in z = 0: flattening z leaves it whole.
+    doc["nodes"][0]["scale"] = {1.0, 1.0, 0.0};
+    EXPECT_NO_THROW(load_gltf(write_file(dir, "flat.gltf", doc.dump())));
+    // Flattening y collapses it to a line.
+    doc["nodes"][0]["scale"] = {1.0, 0.0, 1.0};
+    EXPECT_NE(error_of([&] { load_gltf(write_file(dir, "line.gltf", doc.dump())); }).find("nothing visible"), std::string::npos);
+}
