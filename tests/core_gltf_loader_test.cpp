@@ -762,4 +762,19 @@ TEST(GltfNumbers, ZeroScaleThatLeavesNothingVisibleIsAnError) {
     // Flattening y collapses it to a line.
     doc["nodes"][0]["scale"] = {1.0, 0.0, 1.0};
     EXPECT_NE(error_of([&] { load_gltf(write_file(dir, "line.gltf", doc.dump())); }).find("nothing visible"), std::string::npos);
+    // A model that grows from scale 0 (key times 0 and 1, scales 0 and 1) is visible later.
+    doc["nodes"][0]["scale"] = {0.0, 0.0, 0.0};
+    doc["buffers"].push_back({{"uri", "data:application/octet-stream;base64,AAAAAAAAgD8AAAAAAAAAAAAAAAAAAIA/AACAPwAAgD8="},
+                              {"byteLength", 32}});
+    doc["bufferViews"].push_back({{"buffer", 1}, {"byteLength", 8}});
+    doc["bufferViews"].push_back({{"buffer", 1}, {"byteOffset", 8}, {"byteLength", 24}});
+    doc["accessors"].push_back({{"bufferView", 1}, {"componentType", 5126}, {"count", 2}, {"type", "SCALAR"}, {"min", {0}}, {"max", {1}}});
+    doc["accessors"].push_back({{"bufferView", 2}, {"componentType", 5126}, {"count", 2}, {"type", "VEC3"}});
+    nlohmann::json animation;
+    animation["samplers"] = nlohmann::json::array({nlohmann::json{{"input", 1}, {"output", 2}}});
+    animation["channels"] =
+        nlohmann::json::array({nlohmann::json{{"sampler", 0}, {"target", {{"node", 0}, {"path", "scale"}}}}});
+    doc["animations"] = nlohmann::json::array({animation});
+    const Scene grows = load_gltf(write_file(dir, "grows.gltf", doc.dump()));
+    EXPECT_TRUE(grows.is_animated());
 }
