@@ -15,7 +15,8 @@
 //    JOINTS_1/WEIGHTS_1 are ignored (four influences per vertex) with a warning.
 //  * Morph targets are not supported: the base shape is used and a warning says so.
 //  * Numbers of extensions and cameras are checked like the scene file's own: a light's
-//    colour and intensity must be finite and ≥ 0, spot cones 0 ≤ inner < outer ≤ π/2;
+//    colour and intensity and a material's emissiveStrength must be finite and ≥ 0,
+//    spot cones 0 ≤ inner < outer ≤ π/2;
 //    a perspective camera needs yfov in (0, π), 0 < znear < zfar and aspectRatio > 0.
 //    A degenerate camera is an error naming it (not dropped for the default view);
 //    orthographic cameras are ignored with a warning. Node scales that collapse every
@@ -359,6 +360,21 @@ std::optional<Vec3> mean_texture_color(const tinygltf::Model& m, int texture_ind
     return Vec3(sum / double(n));
 }
 
+// KHR_materials_emissive_strength: a finite number ≥ 0 (1 when absent), checked like a
+// light's intensity.
+float emissive_strength(const std::string& file, const tinygltf::Material& gm, size_t index, const std::string& name) {
+    auto ext = gm.extensions.find("KHR_materials_emissive_strength");
+    if (ext == gm.extensions.end() || !ext->second.Has("emissiveStrength")) return 1.0f;
+    const tinygltf::Value& v = ext->second.Get("emissiveStrength");
+    const double strength = v.IsNumber() ? v.GetNumberAsDouble() : std::nan("");
+    if (!(std::isfinite(strength) && strength >= 0 && strength <= double(std::numeric_limits<float>::max())))
+        throw Error(file, "/materials/" + std::to_string(index) +
+                              "/extensions/KHR_materials_emissive_strength/emissiveStrength: material '" + name + "': " +
+                              (v.IsNumber() ? number_as_given(strength) : std::string("not a number")) +
+                              " is not a strength (need a finite number ≥ 0)");
+    return float(strength);
+}
+
 Material convert_material(Context& ctx, const tinygltf::Material& gm, size_t index) {
     Material out;
     out.name = gm.name.empty() ? "material" + std::to_string(index) : gm.name;
@@ -386,10 +402,7 @@ Material convert_material(Context& ctx, const tinygltf::Material& gm, size_t ind
 
     Vec3 emission(0.0f);
     if (gm.emissiveFactor.size() >= 3) emission = Vec3(gm.emissiveFactor[0], gm.emissiveFactor[1], gm.emissiveFactor[2]);
-    auto ext = gm.extensions.find("KHR_materials_emissive_strength");
-    if (ext != gm.extensions.end() && ext->second.Has("emissiveStrength") &&
-        ext->second.Get("emissiveStrength").IsNumber())
-        emission *= float(ext->second.Get("emissiveStrength").GetNumberAsDouble());
+    emission *= emissive_strength(ctx.file, gm, index, out.name);
     if (gm.emissiveTexture.index >= 0 && max_component(emission) > 0.0f) {
         if (auto mean = mean_texture_color(ctx.model, gm.emissiveTexture.index)) emission *= *mean;
     }

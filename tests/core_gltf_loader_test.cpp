@@ -718,6 +718,13 @@ TEST(GltfNumbers, LightAndCameraValuesAreCheckedLikeTheSceneFile) {
         {"yfov_beyond_pi", with_camera({{"yfov", 4.0}, {"znear", 0.1}}), {"perspective/yfov", "4 is out of range"}},
         {"znear_negative", with_camera({{"yfov", 0.8}, {"znear", -0.1}}), {"perspective/znear", "-0.1"}},
         {"zfar_before_znear", with_camera({{"yfov", 0.8}, {"znear", 0.1}, {"zfar", 0.05}}), {"perspective/zfar", "0.05", "znear = 0.1"}},
+        {"negative_emissive_strength", [] {
+             nlohmann::json doc = triangle_gltf();
+             doc["materials"] = {{{"name", "glow"}, {"emissiveFactor", {1.0, 1.0, 1.0}},
+                                  {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", -3.5}}}}}}};
+             doc["meshes"][0]["primitives"][0]["material"] = 0;
+             return doc;
+         }(), {"/materials/0/extensions/KHR_materials_emissive_strength/emissiveStrength", "material 'glow'", "-3.5"}},
         {"aspect_ratio_negative", with_camera({{"yfov", 0.8}, {"znear", 0.1}, {"aspectRatio", -1.5}}), {"perspective/aspectRatio", "-1.5"}},
     };
     const fs::path dir = test::temp_dir("gltf_numbers");
