@@ -227,6 +227,21 @@ TEST_F(CliBadInput, ReferencedFilesThatAreNotFilesAreRefusedAtOnce) {
     fs::create_symlink("/dev/zero", dir_ / "part.obj");
     const fs::path scene = gilab::test::write_file(dir_, "scene.json", R"({"meshes": [{"file": "part.obj"}]})");
     expect_error(render({}, scene.string()), {"scene.json", "/meshes/0/file", "part.obj", "not a regular file"}, out_);
+    // A glTF whose buffer is a FIFO and one whose texture is /dev/zero.
+    ASSERT_EQ(mkfifo((dir_ / "fifo.bin").c_str(), 0600), 0);
+    fs::create_symlink("/dev/zero", dir_ / "zero.png");
+    const std::string gltf_start = R"({"asset":{"version":"2.0"},"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],
+        "bufferViews":[{"buffer":0,"byteLength":36}],
+        "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)";
+    const fs::path buffer = gilab::test::write_file(dir_, "buffer.gltf", gltf_start + R"(
+        "buffers":[{"uri":"fifo.bin","byteLength":36}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}]})");
+    expect_error(render({}, buffer.string()), {"buffer.gltf", "/buffers/0/uri", "fifo.bin", "not a regular file"}, out_);
+    const fs::path texture = gilab::test::write_file(dir_, "texture.gltf", gltf_start + R"(
+        "buffers":[{"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA","byteLength":36}],
+        "images":[{"uri":"zero.png"}],"textures":[{"source":0}],
+        "materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],
+        "meshes":[{"primitives":[{"attributes":{"POSITION":0},"material":0}]}]})");
+    expect_error(render({}, texture.string()), {"texture.gltf", "/images/0/uri", "zero.png", "not a regular file"}, out_);
 }
 
 TEST_F(CliBadInput, ZeroScaleAndNegativeLightAreErrorsNotImages) {
