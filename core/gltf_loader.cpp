@@ -16,7 +16,7 @@
 //  * Morph targets are not supported: the base shape is used and a warning says so.
 //  * Numbers of extensions and cameras are checked like the scene file's own: a light's
 //    colour and intensity and a material's emissiveStrength must be finite and ≥ 0,
-//    spot cones 0 ≤ inner < outer ≤ π/2;
+//    spot cones 0 ≤ inner ≤ outer ≤ π/2 (outer > 0);
 //    a perspective camera needs yfov in (0, π), 0 < znear < zfar and aspectRatio > 0.
 //    A degenerate camera is an error naming it (not dropped for the default view);
 //    orthographic cameras are ignored with a warning. Node scales that collapse every
@@ -245,7 +245,7 @@ Transform node_local_transform(const tinygltf::Node& n) {
 
 // KHR_lights_punctual numbers are checked like the scene file's own: a negative colour
 // or intensity would add negative radiance (negative pixels), a cone outside
-// 0 ≤ inner < outer ≤ π/2 has no meaning. Errors name the light and its JSON path.
+// 0 ≤ inner ≤ outer ≤ π/2 has no meaning. Errors name the light and its JSON path.
 PunctualLight convert_light(const std::string& file, const tinygltf::Light& gl, int index) {
     PunctualLight light;
     light.name = gl.name.empty() ? "light" + std::to_string(index) : gl.name;
@@ -273,8 +273,8 @@ PunctualLight convert_light(const std::string& file, const tinygltf::Light& gl, 
         const double inner = gl.spot.innerConeAngle, outer = gl.spot.outerConeAngle;
         if (!(outer > 0 && outer <= kPi / 2))
             fail("spot/outerConeAngle", outer, "is out of range (0, π/2]");
-        if (!(inner >= 0 && inner < outer))
-            fail("spot/innerConeAngle", inner, "is out of range [0, outerConeAngle = " + number_as_given(outer) + ")");
+        if (!(inner >= 0 && inner <= outer))  // equal, as Blender writes a hard-edged cone, like the scene file
+            fail("spot/innerConeAngle", inner, "is out of range [0, outerConeAngle = " + number_as_given(outer) + "]");
         light.cos_inner = std::cos(float(inner));
         light.cos_outer = std::cos(float(outer));
     } else if (gl.type == "directional") {

@@ -711,8 +711,8 @@ TEST(GltfNumbers, LightAndCameraValuesAreCheckedLikeTheSceneFile) {
         {"negative_intensity", light({{"intensity", -5.0}}), {"lights/0/intensity", "light 'lamp'", "-5"}},
         {"outer_cone_beyond_90_degrees", light({{"type", "spot"}, {"spot", {{"outerConeAngle", 2.0}}}}),
          {"lights/0/spot/outerConeAngle", "light 'lamp'", "2 is out of range"}},
-        {"inner_cone_equal_to_outer", light({{"type", "spot"}, {"spot", {{"innerConeAngle", 0.5}, {"outerConeAngle", 0.5}}}}),
-         {"lights/0/spot/innerConeAngle", "0.5 is out of range"}},
+        {"inner_cone_beyond_outer", light({{"type", "spot"}, {"spot", {{"innerConeAngle", 0.6}, {"outerConeAngle", 0.5}}}}),
+         {"lights/0/spot/innerConeAngle", "0.6 is out of range [0, outerConeAngle = 0.5]"}},
         {"negative_inner_cone", light({{"type", "spot"}, {"spot", {{"innerConeAngle", -0.1}}}}), {"spot/innerConeAngle", "-0.1"}},
         {"yfov_zero", with_camera({{"yfov", 0.0}, {"znear", 0.1}}), {"/cameras/0/perspective/yfov", "camera 0 'view'", "0 is out of range"}},
         {"yfov_beyond_pi", with_camera({{"yfov", 4.0}, {"znear", 0.1}}), {"perspective/yfov", "4 is out of range"}},
@@ -745,6 +745,10 @@ TEST(GltfNumbers, ValidLightsAndCamerasLoad) {
                                                 .dump()));
     ASSERT_EQ(spot.lights.size(), 1u);
     EXPECT_EQ(spot.lights[0].intensity, Vec3(0.0f));
+    // A hard-edged cone (inner = outer), as Blender writes one without blend.
+    EXPECT_NO_THROW(load_gltf(write_file(
+        dir, "hard_spot.gltf",
+        with_light({{"type", "spot"}, {"spot", {{"innerConeAngle", 0.5}, {"outerConeAngle", 0.5}}}}).dump())));
     const Scene cam = load_gltf(write_file(dir, "camera.gltf",
                                            with_camera({{"yfov", 0.8}, {"znear", 0.1}, {"zfar", 100.0}, {"aspectRatio", 1.5}}).dump()));
     ASSERT_TRUE(cam.camera.has_value());
