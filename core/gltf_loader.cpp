@@ -16,12 +16,11 @@
 //  * Morph targets are not supported: the base shape is used and a warning says so.
 //  * Numbers of extensions and cameras are checked like the scene file's own: a light's
 //    colour and intensity and a material's emissiveStrength must be finite and ≥ 0,
-//    spot cones 0 ≤ inner ≤ outer ≤ π/2 (outer > 0);
-//    a perspective camera needs yfov in (0, π), 0 < znear < zfar and aspectRatio > 0.
-//    A degenerate camera is an error naming it (not dropped for the default view);
-//    orthographic cameras are ignored with a warning. Node scales that collapse every
-//    triangle to zero area, at rest and across the animation, are an error ("nothing
-//    visible"), not a black image.
+//    spot cones 0 ≤ inner ≤ outer ≤ π/2 with outer > 0; a perspective camera needs yfov
+//    in (0, π), 0 < znear < zfar and aspectRatio > 0. A degenerate camera is an error
+//    naming it (not dropped for the default view); orthographic cameras are ignored
+//    with a warning. Node scales that collapse every triangle to zero area, at rest and
+//    across the animation, are an error ("nothing visible"), not a black image.
 //  * Every accessor and index is range-checked: a bad file throws Error, never reads
 //    outside its buffers. The file itself is checked before tinygltf reads it
 //    (core/gltf_checks.hpp), and every allocation sized by the file is checked against
