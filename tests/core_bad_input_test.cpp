@@ -122,8 +122,13 @@ const BadCase kCases[] = {
     {"scene_scale_1e300.json", {"/meshes/0/scale", "1e+300 is out of range"}},
     {"scene_world_overflow.json", {"mesh 'tri'", "1e+30", "beyond the supported range"}},
     {"scene_fps_1e12.json", {"/animation/frames_per_second", "1e+12 is out of range"}},
+    {"scene_fps_1e-300.json", {"/animation/frames_per_second", "1e-300 is too small"}},  // not "0.000000"
     {"scene_key_time_huge.json", {"lasts 1e+30 s", "more than the 1000000 supported"}},
     {"scene_ipd.json", {"/hmd/ipd", "[0, 1)"}},
+    // glTF extension and camera numbers, and transforms that leave nothing to see.
+    {"gltf_light_negative_color.gltf", {"/extensions/KHR_lights_punctual/lights/0/color/0", "light 'lamp'", "-1"}},
+    {"gltf_camera_znear_negative.gltf", {"/cameras/0/perspective/znear", "camera 0 'view'", "-0.1"}},
+    {"gltf_node_scale_zero.gltf", {"nothing visible", "node 'model' has scale [0, 0, 0]"}},
     // Wrong types, unknown keys and keywords, malformed headers.
     {"scene_wrong_type.json", {"/meshes/0/scale", "expected a number or an array of 3 numbers, got string"}},
     {"scene_unknown_key.json", {"/meshes/0/scal", "unknown key 'scal'"}},
