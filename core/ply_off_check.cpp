@@ -476,7 +476,7 @@ public:
                     throw Error(at, "vertex " + std::to_string(v) + " coordinate " + quote(t[k]) + " is not finite (non-finite vertex)");
             }
         }
-        PolygonFileCounts counts_out{vertices_, faces_, 0, keyword_offset_, keyword_length_};
+        PolygonFileCounts counts_out{vertices_, faces_, 0, keyword_offset_, keyword_length_, {}};
         for (uint64_t f = 0; f < faces_; ++f) {
             if (!next_line(t)) truncated("face " + std::to_string(f));
             const std::string at = at_line(line_no_);
