@@ -65,7 +65,7 @@ std::optional<TracePlan> plan_trace(const RenderRequest& request) {
     double frames = request.frames ? double(*request.frames) : std::max(1.0, std::round(duration * plan.fps));
     constexpr double kMaxFrames = 1e6;  // a typo'd --fps should not queue days of rendering
     if (frames > kMaxFrames)
-        throw Error(plan.path, "a " + std::to_string(duration) + " s trace at " + std::to_string(plan.fps) +
+        throw Error(plan.path, "a " + number_as_given(duration) + " s trace at " + number_as_given(plan.fps) +
                                    " fps is more than 1000000 frames; give --frames");
     plan.frames = int(frames);
     return plan;
