@@ -4,6 +4,7 @@
 #include <filesystem>
 #include "core/build_info.hpp"
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 
 namespace gilab {
 
@@ -21,11 +22,6 @@ void append_colon_separated(const std::string& list, std::vector<fs::path>& out)
     }
 }
 
-bool is_file(const fs::path& p) {
-    std::error_code ec;
-    return fs::is_regular_file(p, ec);
-}
-
 }  // namespace
 
 AssetPaths AssetPaths::from_environment(const std::optional<std::string>& flag_value) {
@@ -39,11 +35,11 @@ AssetPaths AssetPaths::from_environment(const std::optional<std::string>& flag_v
 std::optional<fs::path> AssetPaths::find(const std::string& relative) const {
     if (relative.empty()) return std::nullopt;
     const fs::path p(relative);
-    if (is_file(p)) return p;
+    if (regular_file_exists(p)) return p;
     if (p.is_absolute()) return std::nullopt;
     for (const fs::path& dir : dirs_) {
         fs::path candidate = dir / p;
-        if (is_file(candidate)) return candidate;
+        if (regular_file_exists(candidate)) return candidate;
     }
     return std::nullopt;
 }

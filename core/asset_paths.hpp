@@ -17,7 +17,9 @@ public:
 
     // An absolute path or one relative to the working directory is used if it exists;
     // otherwise each search directory is tried in order. Throws Error listing the
-    // directories searched when nothing is found.
+    // directories searched when nothing is found (resolve), and Error(candidate, "is a
+    // ..., not a regular file") when the first candidate there is a device, FIFO or
+    // directory (both).
     std::filesystem::path resolve(const std::string& relative) const;
     std::optional<std::filesystem::path> find(const std::string& relative) const;
     const std::vector<std::filesystem::path>& dirs() const { return dirs_; }

@@ -3,6 +3,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <string>
 #include "core/error.hpp"
+#include "core/format.hpp"
 
 namespace gilab {
 
@@ -12,9 +13,9 @@ void check_tangents(const FrustumTangents& f, const char* where) {
     bool finite = std::isfinite(f.left) && std::isfinite(f.right) && std::isfinite(f.bottom) &&
                   std::isfinite(f.top);
     if (!finite || !(f.left < f.right) || !(f.bottom < f.top)) {
-        throw Error(where, "invalid frustum tangents (left " + std::to_string(f.left) +
-                               ", right " + std::to_string(f.right) + ", bottom " +
-                               std::to_string(f.bottom) + ", top " + std::to_string(f.top) +
+        throw Error(where, "invalid frustum tangents (left " + number_as_given(f.left) +
+                               ", right " + number_as_given(f.right) + ", bottom " +
+                               number_as_given(f.bottom) + ", top " + number_as_given(f.top) +
                                "): need finite values with left < right and bottom < top");
     }
 }
@@ -22,7 +23,7 @@ void check_tangents(const FrustumTangents& f, const char* where) {
 void check_angle(float a, const char* name) {
     if (!std::isfinite(a) || std::abs(a) >= 0.5f * kPi) {
         throw Error("FrustumTangents::from_openxr",
-                    std::string(name) + " = " + std::to_string(a) +
+                    std::string(name) + " = " + number_as_given(a) +
                         " rad is outside (-pi/2, pi/2)");
     }
 }
@@ -32,12 +33,12 @@ void check_angle(float a, const char* name) {
 FrustumTangents FrustumTangents::symmetric(float vertical_fov_degrees, float aspect) {
     if (!(vertical_fov_degrees > 0.0f && vertical_fov_degrees < 180.0f)) {
         throw Error("FrustumTangents::symmetric",
-                    "vertical field of view " + std::to_string(vertical_fov_degrees) +
+                    "vertical field of view " + number_as_given(vertical_fov_degrees) +
                         " degrees is outside (0, 180)");
     }
     if (!(aspect > 0.0f) || !std::isfinite(aspect)) {
         throw Error("FrustumTangents::symmetric",
-                    "aspect ratio " + std::to_string(aspect) + " must be positive");
+                    "aspect ratio " + number_as_given(aspect) + " must be positive");
     }
     float t = std::tan(glm::radians(vertical_fov_degrees) * 0.5f);
     return {-t * aspect, t * aspect, -t, t};
@@ -156,8 +157,8 @@ Mat4 EyeCamera::view_matrix() const {
 Mat4 EyeCamera::projection_matrix(float near_plane, float far_plane) const {
     if (!(near_plane > 0.0f) || !(far_plane > near_plane) || !std::isfinite(far_plane)) {
         throw Error("EyeCamera::projection_matrix",
-                    "need 0 < near < far, got near " + std::to_string(near_plane) + ", far " +
-                        std::to_string(far_plane));
+                    "need 0 < near < far, got near " + number_as_given(near_plane) + ", far " +
+                        number_as_given(far_plane));
     }
     return glm::frustum(fov_.left * near_plane, fov_.right * near_plane,
                         fov_.bottom * near_plane, fov_.top * near_plane, near_plane,

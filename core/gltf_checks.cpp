@@ -148,6 +148,33 @@ uint64_t data_uri_bytes(const std::string& uri) {
     return (n / 4) * 3 - std::min<uint64_t>(pad, (n / 4) * 3);
 }
 
+// The file a uri names, where tinygltf looks for it: beside the glTF file, then in the
+// working directory. Empty when there is none; Error(file, "PTR/uri: 'URI' is a ...,
+// not a regular file") when the name is taken by a device, FIFO or directory.
+fs::path referenced_file(const fs::path& gltf, const std::string& ptr, const std::string& uri) {
+    const std::string name = percent_decode(uri);
+    const std::string dir = gltf.parent_path().string();
+    for (const std::string& candidate : {dir.empty() ? name : dir + "/" + name, "./" + name}) {
+        const std::string problem = non_regular_file_problem(candidate);
+        if (!problem.empty()) throw Error(gltf.string(), ptr + "/uri: '" + uri + "' " + problem);
+        if (regular_file_exists(candidate)) return candidate;
+    }
+    return {};
+}
+
+// External images are read by tinygltf, which turns a failed read into a warning: a
+// device or FIFO named as an image must be refused before it starts.
+void check_images(const json& doc, const fs::path& path) {
+    if (!doc.contains("images") || !doc["images"].is_array()) return;
+    const json& images = doc["images"];
+    for (size_t i = 0; i < images.size(); ++i) {
+        const json& image = images[i];
+        if (!image.is_object() || !image.contains("uri") || !image["uri"].is_string()) continue;
+        const std::string uri = image["uri"].get<std::string>();
+        if (uri.rfind("data:", 0) != 0) referenced_file(path, "/images/" + std::to_string(i), uri);
+    }
+}
+
 uint64_t check_buffers(const json& doc, const fs::path& path, bool glb, bool has_bin, uint64_t bin_length) {
     const std::string file = path.string();
     if (!doc.contains("buffers")) return 0;
@@ -178,24 +205,9 @@ uint64_t check_buffers(const json& doc, const fs::path& path, bool glb, bool has
                     throw Error(file, ptr + "/byteLength: " + std::to_string(*length) + " bytes, but its data URI holds only " +
                                           std::to_string(held));
             } else {
-                // tinygltf looks beside the file, then in the working directory.
-                const std::string name = percent_decode(uri);
-                const std::string dir = path.parent_path().string();
-                fs::path found;
-                for (const std::string& candidate : {dir.empty() ? name : dir + "/" + name, "./" + name}) {
-                    std::error_code ec;
-                    if (fs::exists(candidate, ec)) {
-                        found = candidate;
-                        break;
-                    }
-                }
+                const fs::path found = referenced_file(path, ptr, uri);
                 if (found.empty()) throw Error(file, ptr + "/uri: buffer file '" + uri + "' not found beside the glTF file");
-                uint64_t size = 0;
-                try {
-                    size = input_file_size(found);
-                } catch (const Error& e) {
-                    throw Error(file, ptr + "/uri: '" + uri + "': " + std::string(e.what()).substr(found.string().size() + 2));
-                }
+                const uint64_t size = input_file_size(found);
                 if (size != *length)
                     throw Error(file, ptr + "/byteLength: " + std::to_string(*length) + " bytes, but '" + uri + "' holds " +
                                           std::to_string(size) + (size < *length ? " (truncated?)" : " (they must match)"));
@@ -282,6 +294,7 @@ GltfInput check_gltf_file(const fs::path& path, const std::string& bytes) {
     check_version(doc, file);
     check_extensions(doc, file);
     input.input_bytes = bytes.size() + check_buffers(doc, path, input.binary, has_bin, bin_length);
+    check_images(doc, path);
     return input;
 }
 

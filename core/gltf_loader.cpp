@@ -14,6 +14,13 @@
 //    at evaluation time; the joints are ordinary nodes animated by the TRS channels.
 //    JOINTS_1/WEIGHTS_1 are ignored (four influences per vertex) with a warning.
 //  * Morph targets are not supported: the base shape is used and a warning says so.
+//  * Numbers of extensions and cameras are checked like the scene file's own: a light's
+//    colour and intensity and a material's emissiveStrength must be finite and ≥ 0,
+//    spot cones 0 ≤ inner ≤ outer ≤ π/2 with outer > 0; a perspective camera needs yfov
+//    in (0, π), 0 < znear < zfar and aspectRatio > 0. A degenerate camera is an error
+//    naming it (not dropped for the default view); orthographic cameras are ignored
+//    with a warning. Node scales that collapse every triangle to zero area, at rest and
+//    across the animation, are an error ("nothing visible"), not a black image.
 //  * Every accessor and index is range-checked: a bad file throws Error, never reads
 //    outside its buffers. The file itself is checked before tinygltf reads it
 //    (core/gltf_checks.hpp), and every allocation sized by the file is checked against
@@ -21,11 +28,11 @@
 #include <tiny_gltf.h>
 
 #include <cstring>
-#include <functional>
 #include <map>
 #include <set>
 #include <sstream>
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "core/gltf_checks.hpp"
 #include "core/input_file.hpp"
 #include "core/memory_budget.hpp"
@@ -218,12 +225,9 @@ void check_node_transform(const std::string& file, int index, const tinygltf::No
     for (const auto& [name, values] : parts)
         for (size_t k = 0; k < values->size(); ++k) {
             const double v = (*values)[k];
-            if (!std::isfinite(v) || std::abs(v) > double(std::numeric_limits<float>::max())) {
-                std::ostringstream text;
-                text << v;
+            if (!std::isfinite(v) || std::abs(v) > double(std::numeric_limits<float>::max()))
                 throw Error(file, "/nodes/" + std::to_string(index) + "/" + name + "/" + std::to_string(k) + ": " +
-                                      text.str() + " is out of range (single precision holds at most ±3.4e38)");
-            }
+                                      number_as_given(v) + " is out of range (single precision holds at most ±3.4e38)");
         }
 }
 
@@ -236,6 +240,85 @@ Transform node_local_transform(const tinygltf::Node& n) {
                                          float(n.rotation[2])));
     if (n.scale.size() == 3) t.scale = Vec3(n.scale[0], n.scale[1], n.scale[2]);
     return t;
+}
+
+// KHR_lights_punctual numbers are checked like the scene file's own: a negative colour
+// or intensity would add negative radiance (negative pixels), a cone outside
+// 0 ≤ inner ≤ outer ≤ π/2 has no meaning. Errors name the light and its JSON path.
+PunctualLight convert_light(const std::string& file, const tinygltf::Light& gl, int index) {
+    PunctualLight light;
+    light.name = gl.name.empty() ? "light" + std::to_string(index) : gl.name;
+    const std::string ptr = "/extensions/KHR_lights_punctual/lights/" + std::to_string(index);
+    auto fail = [&](const std::string& key, double value, const std::string& rule) {
+        throw Error(file, ptr + "/" + key + ": light '" + light.name + "': " + number_as_given(value) + " " + rule);
+    };
+    auto finite_float = [](double v) { return std::isfinite(v) && std::abs(v) <= double(std::numeric_limits<float>::max()); };
+    Vec3 color(1.0f);
+    if (gl.color.size() >= 3) {
+        for (size_t k = 0; k < 3; ++k)
+            if (!finite_float(gl.color[k]) || gl.color[k] < 0)
+                fail("color/" + std::to_string(k), gl.color[k], "is not a colour component (need a finite number ≥ 0)");
+        color = Vec3(gl.color[0], gl.color[1], gl.color[2]);
+    }
+    if (!finite_float(gl.intensity) || gl.intensity < 0)
+        fail("intensity", gl.intensity, "is not an intensity (need a finite number ≥ 0)");
+    light.intensity = color * float(gl.intensity);
+    light.position = Vec3(0.0f);
+    light.direction = Vec3(0, 0, -1);  // glTF lights shine down their node's -Z
+    if (gl.type == "point") {
+        light.type = LightType::Point;
+    } else if (gl.type == "spot") {
+        light.type = LightType::Spot;
+        const double inner = gl.spot.innerConeAngle, outer = gl.spot.outerConeAngle;
+        if (!(outer > 0 && outer <= kPi / 2))
+            fail("spot/outerConeAngle", outer, "is out of range (0, π/2]");
+        if (!(inner >= 0 && inner <= outer))  // equal, as Blender writes a hard-edged cone, like the scene file
+            fail("spot/innerConeAngle", inner, "is out of range [0, outerConeAngle = " + number_as_given(outer) + "]");
+        light.cos_inner = std::cos(float(inner));
+        light.cos_outer = std::cos(float(outer));
+    } else if (gl.type == "directional") {
+        light.type = LightType::Directional;
+    } else {
+        throw Error(file, ptr + "/type: light '" + light.name + "' has unknown type '" + gl.type + "'");
+    }
+    return light;
+}
+
+std::string camera_label(const tinygltf::Camera& c, int index) {
+    return "camera " + std::to_string(index) + (c.name.empty() ? "" : " '" + c.name + "'");
+}
+
+// A degenerate camera is an error, as in the scene file, not a camera silently dropped
+// for the default view: yfov in (0, π), 0 < znear < zfar (zfar absent: infinite),
+// aspectRatio > 0 when given (the image's own aspect is used for rendering).
+void check_perspective_camera(const std::string& file, const tinygltf::Camera& c, int index) {
+    const tinygltf::PerspectiveCamera& p = c.perspective;
+    const std::string ptr = "/cameras/" + std::to_string(index) + "/perspective/";
+    auto fail = [&](const char* key, double value, const std::string& rule) {
+        throw Error(file, ptr + key + ": " + camera_label(c, index) + ": " + number_as_given(value) + " " + rule);
+    };
+    if (!(std::isfinite(p.yfov) && p.yfov > 0 && p.yfov < kPi)) fail("yfov", p.yfov, "is out of range (0, π) radians");
+    if (!(std::isfinite(p.znear) && p.znear > 0)) fail("znear", p.znear, "must be a finite number > 0");
+    if (p.zfar != 0 && !(std::isfinite(p.zfar) && p.zfar > p.znear))  // 0: absent, an infinite far plane
+        fail("zfar", p.zfar, "must be a finite number > znear = " + number_as_given(p.znear));
+    if (p.aspectRatio != 0 && !(std::isfinite(p.aspectRatio) && p.aspectRatio > 0))  // 0: absent
+        fail("aspectRatio", p.aspectRatio, "must be a finite number > 0");
+}
+
+// The camera of a node: it looks down the node's -Z with +Y up. A zero scale on the way
+// leaves no direction to look in.
+SceneCamera camera_at_node(const std::string& file, const tinygltf::Camera& c, int index, const Mat4& world, int node) {
+    SceneCamera cam;
+    cam.position = Vec3(world * Vec4(0, 0, 0, 1));
+    const Vec3 forward = Vec3(world * Vec4(0, 0, -1, 0)), up = Vec3(world * Vec4(0, 1, 0, 0));
+    if (!is_finite(cam.position) || !(glm::length(forward) > 0) || !(glm::length(up) > 0) ||
+        !(glm::length(glm::cross(forward, up)) > 0))
+        throw Error(file, "node " + std::to_string(node) + ": its transform leaves " + camera_label(c, index) +
+                              " no position or viewing direction (a zero scale?)");
+    cam.target = cam.position + glm::normalize(forward);
+    cam.up = glm::normalize(up);
+    cam.vertical_fov_degrees = glm::degrees(float(c.perspective.yfov));
+    return cam;
 }
 
 float srgb_to_linear(float c) {
@@ -276,6 +359,21 @@ std::optional<Vec3> mean_texture_color(const tinygltf::Model& m, int texture_ind
     return Vec3(sum / double(n));
 }
 
+// KHR_materials_emissive_strength: a finite number ≥ 0 (1 when absent), checked like a
+// light's intensity.
+float emissive_strength(const std::string& file, const tinygltf::Material& gm, size_t index, const std::string& name) {
+    auto ext = gm.extensions.find("KHR_materials_emissive_strength");
+    if (ext == gm.extensions.end() || !ext->second.Has("emissiveStrength")) return 1.0f;
+    const tinygltf::Value& v = ext->second.Get("emissiveStrength");
+    const double strength = v.IsNumber() ? v.GetNumberAsDouble() : std::nan("");
+    if (!(std::isfinite(strength) && strength >= 0 && strength <= double(std::numeric_limits<float>::max())))
+        throw Error(file, "/materials/" + std::to_string(index) +
+                              "/extensions/KHR_materials_emissive_strength/emissiveStrength: material '" + name + "': " +
+                              (v.IsNumber() ? number_as_given(strength) : std::string("not a number")) +
+                              " is not a strength (need a finite number ≥ 0)");
+    return float(strength);
+}
+
 Material convert_material(Context& ctx, const tinygltf::Material& gm, size_t index) {
     Material out;
     out.name = gm.name.empty() ? "material" + std::to_string(index) : gm.name;
@@ -303,10 +401,7 @@ Material convert_material(Context& ctx, const tinygltf::Material& gm, size_t ind
 
     Vec3 emission(0.0f);
     if (gm.emissiveFactor.size() >= 3) emission = Vec3(gm.emissiveFactor[0], gm.emissiveFactor[1], gm.emissiveFactor[2]);
-    auto ext = gm.extensions.find("KHR_materials_emissive_strength");
-    if (ext != gm.extensions.end() && ext->second.Has("emissiveStrength") &&
-        ext->second.Get("emissiveStrength").IsNumber())
-        emission *= float(ext->second.Get("emissiveStrength").GetNumberAsDouble());
+    emission *= emissive_strength(ctx.file, gm, index, out.name);
     if (gm.emissiveTexture.index >= 0 && max_component(emission) > 0.0f) {
         if (auto mean = mean_texture_color(ctx.model, gm.emissiveTexture.index)) emission *= *mean;
     }
@@ -608,6 +703,40 @@ void add_lines(Context& ctx, const std::string& text) {
         if (!line.empty()) ctx.warn(line);
 }
 
+// Whether some displayed triangle keeps a non-zero area under `world` (one matrix per
+// scene node). Skinned meshes count as visible: their joints give them their shape.
+bool some_triangle_visible(const Scene& scene, const std::vector<Mat4>& world) {
+    for (size_t i = 0; i < scene.nodes.size(); ++i)
+        for (uint32_t m : scene.nodes[i].meshes) {
+            if (scene.nodes[i].skin >= 0) return true;
+            const Mesh& mesh = scene.meshes[m];
+            auto place = [&](uint32_t v) { return Vec3(world[i] * Vec4(mesh.positions[v], 1.0f)); };
+            for (const UVec3& t : mesh.triangles) {
+                const Vec3 a = place(t.x);
+                if (glm::length(glm::cross(place(t.y) - a, place(t.z) - a)) > 0.0f) return true;
+            }
+        }
+    return false;
+}
+
+// A node scale of zero can collapse every triangle: the render would be black with no
+// error. Checked at the rest pose and across the animation (a model may grow from zero).
+void check_something_visible(const Scene& scene, const std::string& file) {
+    if (some_triangle_visible(scene, scene.rest_node_transforms())) return;
+    constexpr int kSampledTimes = 16;
+    for (int k = 0; scene.is_animated() && k <= kSampledTimes; ++k)
+        if (some_triangle_visible(scene, scene.node_transforms(scene.animation_duration() * k / kSampledTimes))) return;
+    std::string culprit;
+    for (size_t i = 0; i < scene.nodes.size() && culprit.empty(); ++i) {
+        const Vec3& s = scene.nodes[i].local.scale;
+        if (s.x == 0 || s.y == 0 || s.z == 0)
+            culprit = " (node '" + scene.nodes[i].name + "' has scale [" + number_as_given(s.x) +
+                      ", " + number_as_given(s.y) + ", " + number_as_given(s.z) + "])";
+    }
+    throw Error(file, "nothing visible: every triangle of the displayed scene has zero area in world space" +
+                          (culprit.empty() ? std::string(" (check the node scales)") : culprit));
+}
+
 }  // namespace
 
 Scene load_gltf(const fs::path& path) {
@@ -657,10 +786,23 @@ Scene load_gltf(const fs::path& path) {
             if (!is_child[i]) roots.push_back(int(i));
     }
 
-    // Depth-first, so parents precede children; rest-pose world matrices on the way.
+    // Depth-first, so parents precede children; rest-pose world matrices on the way. An
+    // explicit stack, not recursion: a valid hierarchy may be thousands of levels deep.
     std::vector<int> gltf_to_node(model.nodes.size(), -1);
     std::vector<Mat4> gltf_world(model.nodes.size(), Mat4(1.0f));
-    std::function<void(int, int, const Mat4&)> visit = [&](int gi, int parent, const Mat4& parent_world) {
+    struct PendingNode {
+        int gltf_index;
+        int parent;         // scene node index, -1 for a root
+        int parent_gltf;    // glTF node index of the parent, -1 for a root
+    };
+    std::vector<PendingNode> pending;
+    auto push_in_order = [&](const std::vector<int>& gltf_nodes, int parent, int parent_gltf) {
+        for (auto it = gltf_nodes.rbegin(); it != gltf_nodes.rend(); ++it) pending.push_back({*it, parent, parent_gltf});
+    };
+    push_in_order(roots, -1, -1);
+    while (!pending.empty()) {
+        const auto [gi, parent, parent_gltf] = pending.back();
+        pending.pop_back();
         if (gi < 0 || size_t(gi) >= model.nodes.size())
             throw Error(file, "node " + std::to_string(gi) + " is out of range (the file has " +
                                   std::to_string(model.nodes.size()) + " nodes)");
@@ -678,11 +820,11 @@ Scene load_gltf(const fs::path& path) {
                                   "'): its matrix does not decompose into a finite translation, rotation and scale");
         const int index = int(scene.nodes.size());
         gltf_to_node[size_t(gi)] = index;
+        const Mat4 parent_world = parent_gltf >= 0 ? gltf_world[size_t(parent_gltf)] : Mat4(1.0f);
         gltf_world[size_t(gi)] = parent_world * node_local_matrix(gn);
         scene.nodes.push_back(std::move(node));
-        for (int child : gn.children) visit(child, index, gltf_world[size_t(gi)]);
-    };
-    for (int r : roots) visit(r, -1, Mat4(1.0f));
+        push_in_order(gn.children, index, gi);
+    }
 
     // Skins, converted once when a displayed node first uses them.
     std::vector<int> skin_slots(model.skins.size(), -1);
@@ -761,41 +903,22 @@ Scene load_gltf(const fs::path& path) {
             if (li < 0 || size_t(li) >= model.lights.size())
                 throw Error(file, "node " + std::to_string(gi) + " references light " + std::to_string(li) +
                                       " but the file has " + std::to_string(model.lights.size()) + " (out of range)");
-            const tinygltf::Light& gl = model.lights[size_t(li)];
-            PunctualLight light;
-            light.name = gl.name.empty() ? "light" + std::to_string(li) : gl.name;
-            Vec3 color(1.0f);
-            if (gl.color.size() >= 3) color = Vec3(gl.color[0], gl.color[1], gl.color[2]);
-            light.intensity = color * float(gl.intensity);
-            light.position = Vec3(0.0f);
-            light.direction = Vec3(0, 0, -1);  // glTF lights shine down their node's -Z
+            PunctualLight light = convert_light(file, model.lights[size_t(li)], li);
             light.node = ni;
-            if (gl.type == "point") {
-                light.type = LightType::Point;
-            } else if (gl.type == "spot") {
-                light.type = LightType::Spot;
-                light.cos_inner = std::cos(float(gl.spot.innerConeAngle));
-                light.cos_outer = std::cos(float(gl.spot.outerConeAngle));
-                if (light.cos_outer > light.cos_inner)
-                    throw Error(file, "light '" + light.name + "': outer cone angle is smaller than the inner one");
-            } else if (gl.type == "directional") {
-                light.type = LightType::Directional;
-            } else {
-                throw Error(file, "light '" + light.name + "' has unknown type '" + gl.type + "'");
-            }
             scene.lights.push_back(light);
         }
-        if (gn.camera >= 0 && !scene.camera && size_t(gn.camera) < model.cameras.size() &&
-            model.cameras[size_t(gn.camera)].type == "perspective" &&
-            model.cameras[size_t(gn.camera)].perspective.yfov > 0 && model.cameras[size_t(gn.camera)].perspective.yfov < kPi &&
-            is_finite(Vec3(gltf_world[gi][3]))) {
-            const Mat4& w = gltf_world[gi];
-            SceneCamera cam;
-            cam.position = Vec3(w * Vec4(0, 0, 0, 1));
-            cam.target = cam.position + glm::normalize(Vec3(w * Vec4(0, 0, -1, 0)));
-            cam.up = glm::normalize(Vec3(w * Vec4(0, 1, 0, 0)));
-            cam.vertical_fov_degrees = glm::degrees(float(model.cameras[size_t(gn.camera)].perspective.yfov));
-            scene.camera = cam;
+        if (gn.camera >= 0) {
+            if (size_t(gn.camera) >= model.cameras.size())
+                throw Error(file, "node " + std::to_string(gi) + " references camera " + std::to_string(gn.camera) +
+                                      " but the file has " + std::to_string(model.cameras.size()) + " (out of range)");
+            const tinygltf::Camera& gc = model.cameras[size_t(gn.camera)];
+            if (gc.type != "perspective") {
+                ctx.warn("camera " + std::to_string(gn.camera) + " ('" + gc.name + "'): only perspective cameras are supported; '" +
+                         gc.type + "' camera ignored");
+            } else {
+                check_perspective_camera(file, gc, gn.camera);
+                if (!scene.camera) scene.camera = camera_at_node(file, gc, gn.camera, gltf_world[gi], int(gi));
+            }
         }
     }
     load_animations(ctx, gltf_to_node);
@@ -804,6 +927,7 @@ Scene load_gltf(const fs::path& path) {
         if (node.skin >= 0)
             for (uint32_t m : node.meshes) check_influences(scene.meshes[m], scene.skins[size_t(node.skin)].joints.size(), file);
     scene.validate();  // node transforms can carry finite geometry beyond the supported range
+    check_something_visible(scene, file);
     return scene;
 }
 

@@ -8,6 +8,7 @@
 #include <sstream>
 #include "core/error.hpp"
 #include "core/film.hpp"
+#include "core/input_file.hpp"
 
 namespace gilab {
 
@@ -137,6 +138,7 @@ EyeCamera HmdRig::eye(Eye which) const {
 }
 
 std::vector<HeadPoseSample> load_head_pose_trace(const std::string& path) {
+    regular_file_exists(path);  // a device or FIFO would be read without end
     std::ifstream in(path);
     if (!in) throw Error(path, "cannot open head-pose trace");
     static const char* kColumns[8] = {"t", "px", "py", "pz", "qw", "qx", "qy", "qz"};

@@ -10,13 +10,39 @@ namespace gilab {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+const char* file_type_name(fs::file_type type) {
+    switch (type) {
+        case fs::file_type::directory: return "a directory";
+        case fs::file_type::character: return "a character device";
+        case fs::file_type::block: return "a block device";
+        case fs::file_type::fifo: return "a FIFO (named pipe)";
+        case fs::file_type::socket: return "a socket";
+        default: return "something other than a file";
+    }
+}
+
+}  // namespace
+
+std::string non_regular_file_problem(const fs::path& path) {
+    std::error_code ec;
+    const fs::file_status status = fs::status(path, ec);  // follows symbolic links
+    if (ec || !fs::exists(status) || fs::is_regular_file(status)) return "";
+    return std::string("is ") + file_type_name(status.type()) + ", not a regular file";
+}
+
+bool regular_file_exists(const fs::path& path) {
+    const std::string problem = non_regular_file_problem(path);
+    if (!problem.empty()) throw Error(path.string(), problem);
+    std::error_code ec;
+    return fs::is_regular_file(path, ec);
+}
+
 uint64_t input_file_size(const fs::path& path) {
     const std::string file = path.string();
+    if (!regular_file_exists(path)) throw Error(file, "file not found");
     std::error_code ec;
-    const fs::file_status status = fs::status(path, ec);
-    if (ec || !fs::exists(status)) throw Error(file, "file not found");
-    if (fs::is_directory(status)) throw Error(file, "is a directory, not a file");
-    if (!fs::is_regular_file(status)) throw Error(file, "is not a regular file (a device, pipe or socket)");
     const uintmax_t size = fs::file_size(path, ec);
     if (ec) throw Error(file, "cannot read file size: " + ec.message());
     return uint64_t(size);

@@ -9,7 +9,19 @@
 
 namespace gilab {
 
-// Size in bytes; throws Error(path, "file not found" | "is a directory, not a file" | ...).
+// Why `path` cannot be read although something is there: "is a directory, not a
+// regular file", "is a character device, not a regular file", "is a FIFO (named pipe),
+// not a regular file", ... Empty when it is a regular file or when nothing is there.
+// Every file gilab reads — meshes, MTL libraries, glTF buffers and images, scene-file
+// references — is checked with this before it is opened: a device reads forever, a
+// FIFO blocks, a directory reads as garbage.
+std::string non_regular_file_problem(const std::filesystem::path& path);
+
+// True when `path` is a regular file, false when nothing is there; throws
+// Error(path, non_regular_file_problem(path)) when something else is.
+bool regular_file_exists(const std::filesystem::path& path);
+
+// Size in bytes; throws Error(path, "file not found" | non_regular_file_problem(path) | ...).
 uint64_t input_file_size(const std::filesystem::path& path);
 
 // The whole file, after input_file_size's checks and MemoryBudget::check of its size.

@@ -5,6 +5,13 @@
 // checked before anything is allocated, so a corrupt or hostile count ends in an Error
 // naming the file, the field and the value, never in gigabytes of allocation or
 // std::bad_alloc. The CLI sets the limit with --memory-limit.
+//
+// Each request is checked on its own against the limit; the budget keeps no running
+// total. What a request grants ends up in long-lived objects (a scene's meshes, a film,
+// a photon map) that have no point at which they would give it back, so a total could
+// only grow, and a process that loads scene after scene would be refused for memory it
+// has long freed. The limit therefore bounds any one size read from input, not the
+// process's total memory.
 #include <cstdint>
 #include <string>
 

@@ -1,7 +1,7 @@
 #include "core/mesh.hpp"
 
-#include <sstream>
 #include "core/error.hpp"
+#include "core/format.hpp"
 
 namespace gilab {
 
@@ -14,9 +14,7 @@ Bounds3 Mesh::bounds() const {
 namespace {
 
 std::string format_vec(const Vec3& v) {
-    std::ostringstream s;
-    s << "(" << v.x << ", " << v.y << ", " << v.z << ")";
-    return s.str();
+    return "(" + number_as_given(v.x) + ", " + number_as_given(v.y) + ", " + number_as_given(v.z) + ")";
 }
 
 std::string mesh_label(const Mesh& mesh) {

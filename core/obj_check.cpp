@@ -96,9 +96,11 @@ ObjScan scan_obj(const fs::path& path, const std::string& text) {
         if (line.rfind("mtllib", 0) == 0 && line.size() > 6 && is_space(line[6])) {
             std::string_view rest = line.substr(7);
             for (std::string_view name = next_token(rest); !name.empty(); name = next_token(rest)) {
-                std::error_code ec;
                 const fs::path candidate = path.parent_path() / std::string(name);
-                if (fs::is_regular_file(candidate, ec)) {
+                // tinyobjloader would read a device or FIFO without end: refuse it here.
+                const std::string problem = non_regular_file_problem(candidate);
+                if (!problem.empty()) throw Error(where, "material library " + quote(name) + " " + problem);
+                if (regular_file_exists(candidate)) {
                     scan.material_libraries.push_back(candidate);
                     break;  // tinyobjloader reads the first one it finds
                 }

@@ -97,6 +97,7 @@ Scene load_ply_or_off(const fs::path& path) {
     scene.name = mesh.name;
     scene.source = file;
     scene.materials.push_back(Material{});
+    scene.warnings = declared.warnings;
     tally.add_notes(file, scene.warnings);
     scene.degenerate_triangles_dropped = validate_and_clean(mesh, 1, file).degenerate_triangles_dropped;
     scene.add_mesh_instance(std::move(mesh));

@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "core/memory_budget.hpp"
 
 namespace gilab {
@@ -37,12 +38,11 @@ std::vector<std::string_view> split(std::string_view line) {
     return tokens;
 }
 
-// An index or count read as a double, printed as an integer when it is one.
+// An index or count read as a double, printed as an integer when it is one and as
+// read otherwise.
 std::string number_text(double v) {
     if (v == std::floor(v) && std::abs(v) < 1e18) return std::to_string(int64_t(v));
-    char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%g", v);
-    return buffer;
+    return number_as_given(v);
 }
 
 std::string quote(std::string_view t) {
@@ -181,6 +181,7 @@ private:
     std::vector<Element> elements_;
     size_t data_ = 0;  // first byte after the header
     PolygonFileCounts counts_;
+    size_t free_text_lines_ = 0;
 
     std::string at_line(size_t line) const { return file_ + ":" + std::to_string(line); }
     std::string at_byte(size_t offset) const { return file_ + " (byte " + std::to_string(offset) + ")"; }
@@ -256,10 +257,22 @@ private:
                 }
                 elements_.back().properties.push_back(p);
             } else {
-                throw Error(where, "malformed PLY header: unknown keyword " + quote(t[0]));
+                note_free_text(where, t[0]);
             }
         }
         throw Error(file_, malformed);
+    }
+
+    // Free text in the header: one note per line for the first few, then a count (a
+    // header of a million such lines must not make a million warnings).
+    void note_free_text(const std::string& where, std::string_view first_word) {
+        constexpr size_t kNotedLines = 5;
+        ++free_text_lines_;
+        if (free_text_lines_ <= kNotedLines)
+            counts_.warnings.push_back(where + ": header line starting with " + quote(first_word) +
+                                       " is not a PLY keyword; ignored");
+        else if (free_text_lines_ == kNotedLines + 1)
+            counts_.warnings.push_back(file_ + ": further header lines that are no PLY keyword ignored");
     }
 
     // Each element's count against the bytes after the header and the budget, before
@@ -463,7 +476,7 @@ public:
                     throw Error(at, "vertex " + std::to_string(v) + " coordinate " + quote(t[k]) + " is not finite (non-finite vertex)");
             }
         }
-        PolygonFileCounts counts_out{vertices_, faces_, 0, keyword_offset_, keyword_length_};
+        PolygonFileCounts counts_out{vertices_, faces_, 0, keyword_offset_, keyword_length_, {}};
         for (uint64_t f = 0; f < faces_; ++f) {
             if (!next_line(t)) truncated("face " + std::to_string(f));
             const std::string at = at_line(line_no_);

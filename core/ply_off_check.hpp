@@ -7,6 +7,7 @@
 // line for text files, the byte offset for binary ones), the element and the value.
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace gilab {
 
@@ -18,6 +19,9 @@ struct PolygonFileCounts {
     // loader can hand CGAL a plain "OFF" (length 0 when the file has no keyword).
     size_t off_keyword_offset = 0;
     size_t off_keyword_length = 0;
+    // Header lines that are no PLY keyword (free text such as "Created by ..."), which
+    // other readers skip: "file:line: ..." notes for the scene's warnings.
+    std::vector<std::string> warnings;
 };
 
 PolygonFileCounts check_ply(const std::string& bytes, const std::string& file);

@@ -1,10 +1,13 @@
 #include "core/scene.hpp"
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "core/skin.hpp"
 
 namespace gilab {
@@ -136,7 +139,7 @@ SceneFrame flatten(const Scene& scene, const std::vector<Mat4>& world, double ti
             if (!finite)
                 throw Error(scene.source.empty() ? scene.name : scene.source,
                             "node " + std::to_string(i) + " ('" + node.name + "') puts mesh '" + mesh.name +
-                                "' at non-finite world positions at t = " + std::to_string(time) +
+                                "' at non-finite world positions at t = " + number_as_given(time) +
                                 " s (its transform overflows)");
             wm.material_ids = mesh.material_ids;
             frame.meshes.push_back(std::move(wm));
@@ -202,11 +205,40 @@ Reach local_reach(const SceneNode& n) {
     return {std::sqrt(3.0) * scale, shift};
 }
 
-Reach matrix_reach(const Mat4& m) {
-    double linear = 0;
-    for (int r = 0; r < 3; ++r)
+template <typename Matrix>
+Reach matrix_reach(const Matrix& m) {
+    double linear = 0, offset = 0;
+    for (int r = 0; r < 3; ++r) {
         linear = std::max(linear, std::abs(double(m[0][r])) + std::abs(double(m[1][r])) + std::abs(double(m[2][r])));
-    return {linear, max_abs(Vec3(m[3]))};
+        offset = std::max(offset, std::abs(double(m[3][r])));
+    }
+    return {linear, offset};
+}
+
+// `outer` applied after `inner`.
+Reach compose(const Reach& outer, const Reach& inner) {
+    return {outer.linear * inner.linear, outer.offset + outer.linear * inner.offset};
+}
+
+glm::dmat4 rest_matrix(const Transform& t) {
+    const glm::dquat rotation(double(t.rotation.w), double(t.rotation.x), double(t.rotation.y), double(t.rotation.z));
+    return glm::translate(glm::dmat4(1.0), glm::dvec3(t.translation)) * glm::mat4_cast(rotation) *
+           glm::scale(glm::dmat4(1.0), glm::dvec3(t.scale));
+}
+
+// A node's world transform as a bound for its animated ancestors (whose keys only give
+// a worst case) followed by the exact product of the static nodes below the last of
+// them. Per-node bounds multiplied down a chain grow geometrically (√3 per rotation,
+// 3^50 for 100 identity nodes); the exact product of static nodes does not.
+struct WorldReach {
+    Reach animated{};             // up to and including the last animated ancestor
+    glm::dmat4 static_part{1.0};  // the static nodes below it, composed exactly
+    Reach reach() const { return compose(animated, matrix_reach(static_part)); }
+};
+
+WorldReach child_reach(const WorldReach& parent, const SceneNode& n) {
+    if (n.animation.empty()) return {parent.animated, parent.static_part * rest_matrix(n.local)};
+    return {compose(parent.reach(), local_reach(n)), glm::dmat4(1.0)};
 }
 
 std::string approx(double x) {
@@ -227,7 +259,7 @@ void Scene::validate() const {
                                        " but the scene has " + std::to_string(meshes.size()));
     if (meshes.empty() || triangle_count() == 0) throw Error(where, "scene has no triangles (empty scene)");
     if (!(std::isfinite(frames_per_second) && frames_per_second > 0))
-        throw Error(where, "frames per second " + approx(frames_per_second) + " must be a positive number");
+        throw Error(where, "frames per second " + number_as_given(frames_per_second) + " must be a positive number");
     if (is_animated()) {
         const double frames = std::floor(animation_duration() * frames_per_second + 1e-6) + 1;
         if (!(frames <= kMaxAnimationFrames))
@@ -282,6 +314,7 @@ void Scene::validate() const {
 // A finite mesh under finite transforms can still overflow (scale 1e30 on a 1e10 model,
 // matrix entries of 1e38): bound every node's reach before anything is rendered.
 void Scene::check_world_reach(const std::string& where) const {
+    std::vector<WorldReach> world_reach(nodes.size());
     std::vector<Reach> world(nodes.size());
     for (size_t i = 0; i < nodes.size(); ++i) {
         const SceneNode& n = nodes[i];
@@ -295,9 +328,8 @@ void Scene::check_world_reach(const std::string& where) const {
         if (!is_finite(t.translation) || !is_finite(t.scale) || !std::isfinite(glm::length(t.rotation)) ||
             !finite_keys(n.animation.translation) || !finite_keys(n.animation.rotation) || !finite_keys(n.animation.scale))
             throw Error(where, "node " + std::to_string(i) + " ('" + n.name + "') has a non-finite transform");
-        const Reach local = local_reach(n);
-        const Reach parent = n.parent >= 0 ? world[size_t(n.parent)] : Reach{};
-        world[i] = {parent.linear * local.linear, parent.offset + parent.linear * local.offset};
+        world_reach[i] = child_reach(n.parent >= 0 ? world_reach[size_t(n.parent)] : WorldReach{}, n);
+        world[i] = world_reach[i].reach();
     }
     std::vector<double> extent(meshes.size());  // largest |coordinate| of each mesh
     for (size_t m = 0; m < meshes.size(); ++m)

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "core/input_file.hpp"
 #include "core/json_document.hpp"
 #include "core/mesh_loaders.hpp"
@@ -24,12 +25,6 @@ namespace {
 // Faster than any display or capture rate; a larger value is a typo (1e12 frames per
 // second would overflow the frame count).
 constexpr double kMaxFramesPerSecond = 1000;
-
-std::string number_text(double x) {
-    std::ostringstream s;
-    s << x;
-    return s.str();
-}
 
 std::string type_name(const json& v) {
     if (v.is_number()) return "number";
@@ -71,12 +66,14 @@ public:
         if (!std::isfinite(d)) fail(ptr, "expected a finite number");
         // Values are stored in single precision: 1e300 would silently become infinity.
         if (std::abs(d) > double(std::numeric_limits<float>::max()))
-            fail(ptr, number_text(d) + " is out of range (single precision holds at most ±3.4e38)");
+            fail(ptr, number_as_given(d) + " is out of range (single precision holds at most ±3.4e38)");
         return float(d);
     }
     float positive(const json& v, const std::string& ptr) const {
-        float x = number(v, ptr);
-        if (!(x > 0)) fail(ptr, "expected a positive number, got " + std::to_string(x));
+        const float x = number(v, ptr);
+        const double given = v.get<double>();
+        if (!(given > 0)) fail(ptr, "expected a positive number, got " + number_as_given(given));
+        if (!(x > 0)) fail(ptr, number_as_given(given) + " is too small (single precision holds positive numbers from 1.4e-45)");
         return x;
     }
     std::string string(const json& v, const std::string& ptr) const {
@@ -156,12 +153,13 @@ struct SceneBuilder {
     }
 
     fs::path resolve(const std::string& name, const std::string& ptr) {
-        if (auto found = assets.find(name)) return *found;
-        std::error_code ec;
-        const fs::path local = json_dir / name;
-        if (fs::is_regular_file(local, ec)) return local;
-        if (fs::is_directory(local, ec) || fs::is_directory(name, ec))
-            in.fail(ptr, "'" + name + "' is a directory, not a mesh file");
+        try {
+            if (auto found = assets.find(name)) return *found;
+            const fs::path local = json_dir / name;
+            if (regular_file_exists(local)) return local;
+        } catch (const Error& e) {  // a device, FIFO or directory by that name
+            in.fail(ptr, "'" + name + "': " + e.what());
+        }
         std::string searched = "the working directory";
         if (!assets.dirs().empty()) searched += ", " + assets.describe();
         searched += ", " + (json_dir.empty() ? std::string(".") : json_dir.string());
@@ -521,8 +519,8 @@ struct SceneBuilder {
         if (v.contains("frames_per_second")) {
             scene.frames_per_second = in.positive(v["frames_per_second"], "/animation/frames_per_second");
             if (scene.frames_per_second > kMaxFramesPerSecond)
-                in.fail("/animation/frames_per_second", number_text(scene.frames_per_second) + " is out of range (0, " +
-                                                            number_text(kMaxFramesPerSecond) + "]");
+                in.fail("/animation/frames_per_second", number_as_given(v["frames_per_second"].get<double>()) +
+                                                            " is out of range (0, " + number_as_given(kMaxFramesPerSecond) + "]");
         }
         if (!v.contains("nodes")) return;
         const json& nodes = v["nodes"];

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <sstream>
+#include "core/format.hpp"
 #include "core/input_file.hpp"
 #include "core/json_document.hpp"
 #include "core/rng.hpp"
@@ -52,9 +53,8 @@ void Settings::check_number(const std::string& key, long double lo, long double 
         x = (long double)d;
     }
     if (x < lo || x > hi) {
-        std::ostringstream range;
-        range << "[" << double(lo) << ", " << double(hi) << "]";
-        throw Error(context_, "setting '" + key + "' = " + v.dump() + " is out of range " + range.str());
+        const std::string range = "[" + number_as_given(double(lo)) + ", " + number_as_given(double(hi)) + "]";
+        throw Error(context_, "setting '" + key + "' = " + v.dump() + " is out of range " + range);
     }
 }
 

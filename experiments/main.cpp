@@ -86,7 +86,8 @@ int main(int argc, char** argv) {
     app.add_option("--memory-limit", memory_limit,
                    "memory budget for everything sized by input (vertex, face and list counts, glTF buffers, images, "
                    "frames, film size): bytes or a size such as 8G or 512M; default half the physical memory (" +
-                       MemoryBudget::format(MemoryBudget::default_limit()) + " here)");
+                       MemoryBudget::format(MemoryBudget::default_limit()) +
+                       " here). It applies to each request on its own, not to their sum");
 
     RenderRequest request;
     uint64_t seed = 1;

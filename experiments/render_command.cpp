@@ -9,6 +9,7 @@
 #include <sstream>
 #include "core/error.hpp"
 #include "core/film.hpp"
+#include "core/format.hpp"
 #include "core/hmd.hpp"
 #include "core/image_io.hpp"
 #include "core/memory_budget.hpp"
@@ -64,7 +65,7 @@ std::optional<TracePlan> plan_trace(const RenderRequest& request) {
     double frames = request.frames ? double(*request.frames) : std::max(1.0, std::round(duration * plan.fps));
     constexpr double kMaxFrames = 1e6;  // a typo'd --fps should not queue days of rendering
     if (frames > kMaxFrames)
-        throw Error(plan.path, "a " + std::to_string(duration) + " s trace at " + std::to_string(plan.fps) +
+        throw Error(plan.path, "a " + number_as_given(duration) + " s trace at " + number_as_given(plan.fps) +
                                    " fps is more than 1000000 frames; give --frames");
     plan.frames = int(frames);
     return plan;
@@ -86,19 +87,13 @@ std::string default_output(const Scene& scene, const Technique& technique, bool 
     return "results/render/" + scene.name + "_" + technique.name() + (stereo ? "_stereo" : "");
 }
 
-std::string number_text(double value) {
-    std::ostringstream out;
-    out << value;
-    return out.str();
-}
-
 // Every option is checked before the scene loads, so a bad value never costs a render
 // and never leaves a file behind.
 void check_options(const RenderRequest& request) {
-    if (!std::isfinite(request.time)) throw Error("--time", number_text(request.time) + " is not a finite number of seconds");
+    if (!std::isfinite(request.time)) throw Error("--time", number_as_given(request.time) + " is not a finite number of seconds");
     if (request.ipd && !(*request.ipd >= 0 && *request.ipd < 1))
-        throw Error("--ipd", number_text(*request.ipd) + " is out of range: give metres in [0, 1), e.g. 0.063");
-    if (!std::isfinite(request.exposure)) throw Error("--exposure", number_text(request.exposure) + " is not a finite number of stops");
+        throw Error("--ipd", number_as_given(*request.ipd) + " is out of range: give metres in [0, 1), e.g. 0.063");
+    if (!std::isfinite(request.exposure)) throw Error("--exposure", number_as_given(request.exposure) + " is not a finite number of stops");
     if (request.output.empty()) return;
     // An explicit -o never creates directories: a mistyped directory would otherwise
     // scatter results where nobody looks.

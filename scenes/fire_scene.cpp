@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "core/rng.hpp"
 #include "scenes/procedural_meshes.hpp"
 
@@ -146,7 +147,7 @@ Scene make_fire_scene(const FireOptions& options) {
         throw Error("fire scene", "needs at least one particle, not " + std::to_string(options.particles));
     if (options.frames < 2) throw Error("fire scene", "needs at least 2 frames, not " + std::to_string(options.frames));
     if (!(options.fps > 0) || !std::isfinite(options.fps))
-        throw Error("fire scene", "frames per second must be positive and finite, not " + std::to_string(options.fps));
+        throw Error("fire scene", "frames per second must be positive and finite, not " + number_as_given(options.fps));
 
     Scene scene;
     scene.name = "fire";

@@ -4,6 +4,7 @@
 // and no file left in the output directory.
 #include <gtest/gtest.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -159,6 +160,7 @@ TEST_F(CliBadInput, GlobalOptionsAreChecked) {
     EXPECT_FALSE(contains(threads.output, "1797693")) << "prints the largest double as a bound: " << threads.output;
     const GilabRun help = run_gilab({"--help"});
     EXPECT_TRUE(contains(help.output, "--memory-limit")) << help.output;
+    EXPECT_TRUE(contains(help.output, "each request on its own")) << "--help must say how the limit applies: " << help.output;
 }
 
 TEST_F(CliBadInput, UnicodePathIsNamedInTheError) {
@@ -183,4 +185,80 @@ TEST_F(CliBadInput, FlatModelWithoutCameraIsSeen) {
     float brightest = 0;
     for (float v : film.layer("color").data) brightest = std::max(brightest, v);
     EXPECT_GT(brightest, 0.0f) << "the default camera's image is black";
+}
+
+TEST_F(CliBadInput, DeepNodeHierarchyRenders) {
+    // 20000 nested nodes above one triangle: a stack overflow (SIGSEGV) when the
+    // hierarchy was walked recursively.
+    constexpr int kDepth = 20000;
+    std::string nodes;
+    for (int i = 0; i < kDepth; ++i) {
+        if (i > 0) nodes += ',';
+        if (i + 1 < kDepth) {
+            nodes += R"({"children":[)";
+            nodes += std::to_string(i + 1);
+            nodes += "]}";
+        } else {
+            nodes += R"({"mesh":0})";
+        }
+    }
+    const std::string triangle = R"("buffers":[{"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA","byteLength":36}],
+        "bufferViews":[{"buffer":0,"byteLength":36}],
+        "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
+        "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}])";
+    const fs::path chain = gilab::test::write_file(dir_, "chain.gltf",
+                                                   R"({"asset":{"version":"2.0"},)" + triangle + R"(,"nodes":[)" + nodes +
+                                                       R"(],"scenes":[{"nodes":[0]}],"scene":0})");
+    const GilabRun r = run_gilab(render({}, chain.string()));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_TRUE(fs::exists(out_ / "image.exr"));
+    EXPECT_LT(r.peak_rss_kb, kMaxPeakKb);
+}
+
+TEST_F(CliBadInput, ReferencedFilesThatAreNotFilesAreRefusedAtOnce) {
+    // An MTL pointing to /dev/zero read for 95 s and reached 15 GB; a FIFO blocks on open.
+    fs::create_symlink("/dev/zero", dir_ / "zero.mtl");
+    ASSERT_EQ(mkfifo((dir_ / "fifo.mtl").c_str(), 0600), 0);
+    const std::string triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    const fs::path zero = gilab::test::write_file(dir_, "zero.obj", "mtllib zero.mtl\n" + triangle);
+    const fs::path fifo = gilab::test::write_file(dir_, "fifo.obj", "mtllib fifo.mtl\n" + triangle);
+    expect_error(render({}, zero.string()), {"zero.obj", "zero.mtl", "is a character device, not a regular file"}, out_);
+    expect_error(render({}, fifo.string()), {"fifo.obj", "fifo.mtl", "is a FIFO (named pipe), not a regular file"}, out_);
+    fs::create_symlink("/dev/zero", dir_ / "part.obj");
+    const fs::path scene = gilab::test::write_file(dir_, "scene.json", R"({"meshes": [{"file": "part.obj"}]})");
+    expect_error(render({}, scene.string()), {"scene.json", "/meshes/0/file", "part.obj", "not a regular file"}, out_);
+    // A glTF whose buffer is a FIFO and one whose texture is /dev/zero.
+    ASSERT_EQ(mkfifo((dir_ / "fifo.bin").c_str(), 0600), 0);
+    fs::create_symlink("/dev/zero", dir_ / "zero.png");
+    const std::string gltf_start = R"({"asset":{"version":"2.0"},"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],
+        "bufferViews":[{"buffer":0,"byteLength":36}],
+        "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)";
+    const fs::path buffer = gilab::test::write_file(dir_, "buffer.gltf", gltf_start + R"(
+        "buffers":[{"uri":"fifo.bin","byteLength":36}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}]})");
+    expect_error(render({}, buffer.string()), {"buffer.gltf", "/buffers/0/uri", "fifo.bin", "not a regular file"}, out_);
+    const fs::path texture = gilab::test::write_file(dir_, "texture.gltf", gltf_start + R"(
+        "buffers":[{"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA","byteLength":36}],
+        "images":[{"uri":"zero.png"}],"textures":[{"source":0}],
+        "materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],
+        "meshes":[{"primitives":[{"attributes":{"POSITION":0},"material":0}]}]})");
+    expect_error(render({}, texture.string()), {"texture.gltf", "/images/0/uri", "zero.png", "not a regular file"}, out_);
+}
+
+TEST_F(CliBadInput, ZeroScaleAndNegativeLightAreErrorsNotImages) {
+    // Both rendered and exited 0: an all-black image, and one with negative pixels.
+    const std::string triangle = R"({"asset":{"version":"2.0"},
+        "buffers":[{"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA","byteLength":36}],
+        "bufferViews":[{"buffer":0,"byteLength":36}],
+        "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
+        "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)";
+    const fs::path zero = gilab::test::write_file(
+        dir_, "zero_scale.gltf", triangle + R"("nodes":[{"mesh":0,"scale":[0,0,0]}],"scenes":[{"nodes":[0]}]})");
+    expect_error(render({}, zero.string()), {"zero_scale.gltf", "nothing visible"}, out_);
+    const fs::path light = gilab::test::write_file(
+        dir_, "negative_light.gltf",
+        triangle + R"("extensionsUsed":["KHR_lights_punctual"],
+        "extensions":{"KHR_lights_punctual":{"lights":[{"type":"point","name":"lamp","color":[1,-2,1]}]}},
+        "nodes":[{"mesh":0},{"translation":[0,0,2],"extensions":{"KHR_lights_punctual":{"light":0}}}],
+        "scenes":[{"nodes":[0,1]}]})");
+    expect_error(render({}, light.string()), {"negative_light.gltf", "light 'lamp'", "color/1", "-2"}, out_);
 }

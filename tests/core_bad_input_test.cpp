@@ -5,8 +5,10 @@
 // Truncations of valid files at several offsets and the memory budget are checked too.
 #include <gtest/gtest.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include "core/error.hpp"
 #include "core/memory_budget.hpp"
@@ -118,10 +120,15 @@ const BadCase kCases[] = {
     {"gltf_node_scale_overflow.gltf", {"node 0", "mesh 'mesh0'", "beyond the supported range"}},
     {"scene_number_overflow.json", {":1:51:", "/meshes/0/scale", "number 1e999 is out of range"}},
     {"scene_scale_1e300.json", {"/meshes/0/scale", "1e+300 is out of range"}},
-    {"scene_world_overflow.json", {"mesh 'tri'", "3e+30", "beyond the supported range"}},
+    {"scene_world_overflow.json", {"mesh 'tri'", "1e+30", "beyond the supported range"}},
     {"scene_fps_1e12.json", {"/animation/frames_per_second", "1e+12 is out of range"}},
+    {"scene_fps_1e-300.json", {"/animation/frames_per_second", "1e-300 is too small"}},  // not "0.000000"
     {"scene_key_time_huge.json", {"lasts 1e+30 s", "more than the 1000000 supported"}},
     {"scene_ipd.json", {"/hmd/ipd", "[0, 1)"}},
+    // glTF extension and camera numbers, and transforms that leave nothing to see.
+    {"gltf_light_negative_color.gltf", {"/extensions/KHR_lights_punctual/lights/0/color/0", "light 'lamp'", "-1"}},
+    {"gltf_camera_znear_negative.gltf", {"/cameras/0/perspective/znear", "camera 0 'view'", "-0.1"}},
+    {"gltf_node_scale_zero.gltf", {"nothing visible", "node 'model' has scale [0, 0, 0]"}},
     // Wrong types, unknown keys and keywords, malformed headers.
     {"scene_wrong_type.json", {"/meshes/0/scale", "expected a number or an array of 3 numbers, got string"}},
     {"scene_unknown_key.json", {"/meshes/0/scal", "unknown key 'scal'"}},
@@ -153,9 +160,9 @@ const BadCase kCases[] = {
     {"obj_utf16.obj", {"UTF-16", "not supported"}},
     {"scene_utf16.json", {"UTF-16", "not supported"}},
     // Paths that are not mesh files.
-    {"directory.obj", {"is a directory, not a file"}},
-    {"gltf_buffer_uri_dot.gltf", {"/buffers/0/uri", "'.'", "is a directory"}},
-    {"scene_directory_mesh.json", {"/meshes/0/file", "'directory.obj' is a directory"}},
+    {"directory.obj", {"is a directory, not a regular file"}},
+    {"gltf_buffer_uri_dot.gltf", {"/buffers/0/uri", "'.'", "is a directory, not a regular file"}},
+    {"scene_directory_mesh.json", {"/meshes/0/file", "'directory.obj'", "is a directory, not a regular file"}},
     {"scene_missing_mesh.json", {"/meshes/0/file", "'base/no_such_mesh.obj' not found"}},
 };
 
@@ -227,6 +234,77 @@ TEST(BadInputTruncation, ValidFilesCutAtSeveralOffsets) {
     }
 }
 
+// ---------------------------------------------------------------- files that are not files
+
+// Puts something that is not a regular file at `at`: /dev/zero (reads without end), a
+// FIFO (blocks on open until a writer comes) or a directory.
+void make_non_regular(const fs::path& at, const std::string& kind) {
+    if (kind == "device") fs::create_symlink("/dev/zero", at);
+    else if (kind == "fifo") ASSERT_EQ(mkfifo(at.c_str(), 0600), 0) << at;
+    else fs::create_directory(at);
+}
+
+// Loading `path`, which references `referenced`, fails at once naming both, with the
+// words "not a regular file" (not "not found"), without allocating much.
+void expect_refused(const fs::path& path, const std::string& referenced) {
+    const long before = peak_rss_kb();
+    const std::string message = error_loading(path);
+    EXPECT_NE(message.find(path.filename().string()), std::string::npos) << message;
+    EXPECT_NE(message.find(referenced), std::string::npos) << message;
+    EXPECT_NE(message.find("not a regular file"), std::string::npos) << message;
+    EXPECT_EQ(message.find("not found"), std::string::npos) << message;
+    EXPECT_LT(peak_rss_kb() - before, kMaxGrowthKb) << path;
+}
+
+std::string triangle_gltf_with(const std::function<void(nlohmann::json&)>& change) {
+    std::ifstream in(bad_dir() / "base" / "triangle.gltf");
+    nlohmann::json doc = nlohmann::json::parse(in);
+    change(doc);
+    return doc.dump();
+}
+
+class NonRegularFile : public ::testing::TestWithParam<std::string> {
+protected:
+    fs::path dir() const { return test::temp_dir("non_regular_" + GetParam()); }
+};
+
+TEST_P(NonRegularFile, AsMaterialLibrary) {
+    // An MTL that was /dev/zero read for 95 s and reached 15 GB.
+    const fs::path d = dir();
+    make_non_regular(d / "lib.mtl", GetParam());
+    expect_refused(test::write_file(d, "mesh.obj", "mtllib lib.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), "lib.mtl");
+}
+
+TEST_P(NonRegularFile, AsGltfBuffer) {
+    const fs::path d = dir();
+    make_non_regular(d / "data.bin", GetParam());
+    expect_refused(test::write_file(d, "buffer.gltf", triangle_gltf_with([](nlohmann::json& doc) {
+                                        doc["buffers"][0]["uri"] = "data.bin";
+                                    })),
+                   "data.bin");
+}
+
+TEST_P(NonRegularFile, AsGltfImage) {
+    const fs::path d = dir();
+    make_non_regular(d / "texture.png", GetParam());
+    expect_refused(test::write_file(d, "image.gltf", triangle_gltf_with([](nlohmann::json& doc) {
+                                        doc["images"] = {{{"uri", "texture.png"}}};
+                                        doc["textures"] = {{{"source", 0}}};
+                                        doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
+                                        doc["meshes"][0]["primitives"][0]["material"] = 0;
+                                    })),
+                   "texture.png");
+}
+
+TEST_P(NonRegularFile, AsSceneFileMesh) {
+    const fs::path d = dir();
+    make_non_regular(d / "part.obj", GetParam());
+    expect_refused(test::write_file(d, "scene.json", R"({"meshes": [{"file": "part.obj"}]})"), "part.obj");
+}
+
+INSTANTIATE_TEST_SUITE_P(Kinds, NonRegularFile, ::testing::Values("device", "fifo", "directory"),
+                         [](const auto& info) { return info.param; });
+
 // ---------------------------------------------------------------- memory budget
 
 TEST(MemoryBudget, ParsesSizes) {
@@ -271,6 +349,16 @@ TEST(MemoryBudget, ChecksNameWhatAndWhere) {
     msg = test::error_of([] { MemoryBudget::check_count(20, 4, 100, 64, "face count", "x.ply"); });
     EXPECT_NE(msg.find("x.ply: face count 20 needs 1.2 KiB (1280 bytes)"), std::string::npos) << msg;
     EXPECT_EQ(MemoryBudget::times(uint64_t(1) << 40, uint64_t(1) << 40), UINT64_MAX);  // saturates
+}
+
+TEST(MemoryBudget, AppliesToEachRequestOnItsOwn) {
+    // The documented rule (README, --help): no running total, so requests that each fit
+    // pass however many there are, and one that does not fit is refused alone.
+    ScopedMemoryLimit limit(1000);
+    for (int i = 0; i < 3; ++i) EXPECT_NO_THROW(MemoryBudget::check(600, "a 600-byte request", "test"));
+    EXPECT_NE(test::error_of([] { MemoryBudget::check(1001, "a 1001-byte request", "test"); }).find("memory limit of 1000"),
+              std::string::npos);
+    for (int i = 0; i < 3; ++i) EXPECT_NO_THROW(load_any(bad_dir() / "base" / "tri.obj"));
 }
 
 TEST(MemoryBudget, LoadersRefuseFilesBeyondTheBudget) {

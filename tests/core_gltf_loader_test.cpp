@@ -7,6 +7,7 @@
 
 #include <cstring>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include "core/error.hpp"
 #include "core/mesh_loaders.hpp"
 #include "core/scene_file.hpp"
@@ -598,4 +599,193 @@ TEST(RealGlb, CesiumManTextureTintsAlbedo) {
     // The base colour factor is white; the texture's mean colour must pull it below 1.
     EXPECT_LT(max_component(s.materials[0].albedo), 0.9f);
     EXPECT_GT(max_component(s.materials[0].albedo), 0.0f);
+}
+
+// ---------------------------------------------------------------- deep node hierarchies
+
+namespace {
+
+// tests/data/bad/base/triangle.gltf as JSON, to build variants of.
+nlohmann::json triangle_gltf() {
+    std::ifstream in(fs::path(GILAB_SOURCE_DIR) / "tests" / "data" / "bad" / "base" / "triangle.gltf");
+    return nlohmann::json::parse(in);
+}
+
+// The triangle under a chain of `depth` nodes, each the only child of the one before,
+// every node built from `node_template` (its transform).
+nlohmann::json node_chain(size_t depth, const nlohmann::json& node_template) {
+    nlohmann::json doc = triangle_gltf();
+    doc["nodes"] = nlohmann::json::array();
+    for (size_t i = 0; i < depth; ++i) {
+        nlohmann::json node = node_template;
+        if (i + 1 < depth) node["children"] = {i + 1};
+        else node["mesh"] = 0;
+        doc["nodes"].push_back(node);
+    }
+    doc["scenes"] = {{{"nodes", {0}}}};
+    return doc;
+}
+
+}  // namespace
+
+TEST(GltfDeepHierarchy, ChainsThousandsOfNodesDeepLoad) {
+    // The hierarchy was walked recursively: 20000 levels overflowed the stack (SIGSEGV).
+    const fs::path dir = test::temp_dir("gltf_deep_chain");
+    for (size_t depth : {size_t(5000), size_t(50000)}) {
+        const std::string name = "chain" + std::to_string(depth) + ".gltf";
+        const Scene s = load_gltf(write_file(dir, name, node_chain(depth, {{"translation", {0.0, 0.0, 0.0}}}).dump()));
+        ASSERT_EQ(s.nodes.size(), depth);
+        for (size_t i = 1; i < s.nodes.size(); ++i) ASSERT_EQ(s.nodes[i].parent, int(i - 1));
+        EXPECT_EQ(s.nodes.back().meshes.size(), 1u);
+        EXPECT_EQ(s.triangle_count(), 1u);
+    }
+}
+
+TEST(GltfDeepHierarchy, IdentityChainOfHundredNodesLoads) {
+    // Each node's rotation was bounded by √3 and the bounds multiplied: 100 identity
+    // nodes were refused as reaching "coordinates of about 1.35e+18".
+    const nlohmann::json identity = {{"translation", {0.0, 0.0, 0.0}}, {"rotation", {0.0, 0.0, 0.0, 1.0}}, {"scale", {1.0, 1.0, 1.0}}};
+    const fs::path dir = test::temp_dir("gltf_identity_chain");
+    const Scene s = load_gltf(write_file(dir, "identity.gltf", node_chain(100, identity).dump()));
+    EXPECT_EQ(s.nodes.size(), 100u);
+    const SceneFrame frame = s.evaluate(0.0);
+    EXPECT_NEAR(frame.bounds.max.x, 1.0f, 1e-5f);
+    // A quarter turn per node composes to whole turns, not to a product of bounds.
+    const double s2 = std::sqrt(0.5);
+    const nlohmann::json quarter_turn = {{"rotation", {0.0, 0.0, s2, s2}}};
+    EXPECT_NO_THROW(load_gltf(write_file(dir, "turns.gltf", node_chain(100, quarter_turn).dump())));
+}
+
+TEST(GltfDeepHierarchy, ComposedTransformBeyondTheRangeIsStillRefused) {
+    // Scale 100 at each of 10 levels: 1e20, beyond ±1e18, though each node is modest.
+    const fs::path path = write_file(test::temp_dir("gltf_composed_overflow"), "far.gltf",
+                                     node_chain(10, {{"scale", {100.0, 100.0, 100.0}}}).dump());
+    const std::string msg = error_of([&] { load_gltf(path); });
+    EXPECT_NE(msg.find("far.gltf"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("beyond the supported range"), std::string::npos) << msg;
+}
+
+// ---------------------------------------------------------------- extension and camera numbers
+
+namespace {
+
+// The triangle plus a node carrying a KHR_lights_punctual light.
+nlohmann::json with_light(const nlohmann::json& light) {
+    nlohmann::json doc = triangle_gltf();
+    doc["extensionsUsed"] = {"KHR_lights_punctual"};
+    doc["extensions"]["KHR_lights_punctual"]["lights"] = {light};
+    doc["nodes"].push_back({{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+    doc["scenes"][0]["nodes"] = {0, 1};
+    return doc;
+}
+
+// The triangle plus a node carrying a perspective camera.
+nlohmann::json with_camera(const nlohmann::json& perspective) {
+    nlohmann::json doc = triangle_gltf();
+    doc["cameras"] = {{{"type", "perspective"}, {"name", "view"}, {"perspective", perspective}}};
+    doc["nodes"].push_back({{"camera", 0}, {"translation", {0.0, 0.0, 5.0}}});
+    doc["scenes"][0]["nodes"] = {0, 1};
+    return doc;
+}
+
+struct NumberCase {
+    const char* name;
+    nlohmann::json doc;
+    std::vector<std::string> expected;  // substrings of the error
+};
+
+}  // namespace
+
+TEST(GltfNumbers, LightAndCameraValuesAreCheckedLikeTheSceneFile) {
+    // Each was accepted: a negative colour rendered negative pixels, a degenerate camera
+    // was dropped silently for the default view.
+    const nlohmann::json point = {{"type", "point"}, {"name", "lamp"}};
+    auto light = [&](nlohmann::json changes) {
+        nlohmann::json l = point;
+        l.update(changes);
+        return with_light(l);
+    };
+    const NumberCase cases[] = {
+        {"negative_colour", light({{"color", {-1.0, 1.0, 1.0}}}), {"/extensions/KHR_lights_punctual/lights/0/color/0", "light 'lamp'", "-1"}},
+        {"huge_colour", light({{"color", {1.0, 1e39, 1.0}}}), {"lights/0/color/1", "light 'lamp'", "1e+39"}},
+        {"negative_intensity", light({{"intensity", -5.0}}), {"lights/0/intensity", "light 'lamp'", "-5"}},
+        {"outer_cone_beyond_90_degrees", light({{"type", "spot"}, {"spot", {{"outerConeAngle", 2.0}}}}),
+         {"lights/0/spot/outerConeAngle", "light 'lamp'", "2 is out of range"}},
+        {"inner_cone_beyond_outer", light({{"type", "spot"}, {"spot", {{"innerConeAngle", 0.6}, {"outerConeAngle", 0.5}}}}),
+         {"lights/0/spot/innerConeAngle", "0.6 is out of range [0, outerConeAngle = 0.5]"}},
+        {"negative_inner_cone", light({{"type", "spot"}, {"spot", {{"innerConeAngle", -0.1}}}}), {"spot/innerConeAngle", "-0.1"}},
+        {"yfov_zero", with_camera({{"yfov", 0.0}, {"znear", 0.1}}), {"/cameras/0/perspective/yfov", "camera 0 'view'", "0 is out of range"}},
+        {"yfov_beyond_pi", with_camera({{"yfov", 4.0}, {"znear", 0.1}}), {"perspective/yfov", "4 is out of range"}},
+        {"znear_negative", with_camera({{"yfov", 0.8}, {"znear", -0.1}}), {"perspective/znear", "-0.1"}},
+        {"zfar_before_znear", with_camera({{"yfov", 0.8}, {"znear", 0.1}, {"zfar", 0.05}}), {"perspective/zfar", "0.05", "znear = 0.1"}},
+        {"negative_emissive_strength", [] {
+             nlohmann::json doc = triangle_gltf();
+             doc["materials"] = {{{"name", "glow"}, {"emissiveFactor", {1.0, 1.0, 1.0}},
+                                  {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", -3.5}}}}}}};
+             doc["meshes"][0]["primitives"][0]["material"] = 0;
+             return doc;
+         }(), {"/materials/0/extensions/KHR_materials_emissive_strength/emissiveStrength", "material 'glow'", "-3.5"}},
+        {"aspect_ratio_negative", with_camera({{"yfov", 0.8}, {"znear", 0.1}, {"aspectRatio", -1.5}}), {"perspective/aspectRatio", "-1.5"}},
+    };
+    const fs::path dir = test::temp_dir("gltf_numbers");
+    for (const NumberCase& c : cases) {
+        const std::string file = std::string(c.name) + ".gltf";
+        const fs::path path = write_file(dir, file, c.doc.dump());
+        const std::string msg = error_of([&] { load_gltf(path); });
+        EXPECT_NE(msg.find(file), std::string::npos) << c.name << ": " << msg;
+        for (const std::string& part : c.expected) EXPECT_NE(msg.find(part), std::string::npos) << c.name << ": missing '" << part << "' in: " << msg;
+    }
+}
+
+TEST(GltfNumbers, ValidLightsAndCamerasLoad) {
+    const fs::path dir = test::temp_dir("gltf_numbers_valid");
+    const Scene spot = load_gltf(write_file(dir, "spot.gltf",
+                                            with_light({{"type", "spot"}, {"color", {1.0, 0.5, 0.0}}, {"intensity", 0.0},
+                                                        {"spot", {{"innerConeAngle", 0.0}, {"outerConeAngle", kPi / 2}}}})
+                                                .dump()));
+    ASSERT_EQ(spot.lights.size(), 1u);
+    EXPECT_EQ(spot.lights[0].intensity, Vec3(0.0f));
+    // A hard-edged cone (inner = outer), as Blender writes one without blend.
+    EXPECT_NO_THROW(load_gltf(write_file(
+        dir, "hard_spot.gltf",
+        with_light({{"type", "spot"}, {"spot", {{"innerConeAngle", 0.5}, {"outerConeAngle", 0.5}}}}).dump())));
+    const Scene cam = load_gltf(write_file(dir, "camera.gltf",
+                                           with_camera({{"yfov", 0.8}, {"znear", 0.1}, {"zfar", 100.0}, {"aspectRatio", 1.5}}).dump()));
+    ASSERT_TRUE(cam.camera.has_value());
+    EXPECT_NEAR(cam.camera->vertical_fov_degrees, glm::degrees(0.8f), 1e-4f);
+    const Scene infinite = load_gltf(write_file(dir, "infinite.gltf", with_camera({{"yfov", 0.8}, {"znear", 0.1}}).dump()));
+    EXPECT_TRUE(infinite.camera.has_value());
+}
+
+TEST(GltfNumbers, ZeroScaleThatLeavesNothingVisibleIsAnError) {
+    // Rendered an all-black image with exit status 0.
+    const fs::path dir = test::temp_dir("gltf_zero_scale");
+    nlohmann::json doc = triangle_gltf();
+    doc["nodes"][0]["name"] = "model";
+    doc["nodes"][0]["scale"] = {0.0, 0.0, 0.0};
+    const std::string msg = error_of([&] { load_gltf(write_file(dir, "zero.gltf", doc.dump())); });
+    EXPECT_NE(msg.find("zero.gltf"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("nothing visible"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("node 'model' has scale [0, 0, 0]"), std::string::npos) << msg;
+    // The triangle lies in z = 0: flattening z leaves it whole.
+    doc["nodes"][0]["scale"] = {1.0, 1.0, 0.0};
+    EXPECT_NO_THROW(load_gltf(write_file(dir, "flat.gltf", doc.dump())));
+    // Flattening y collapses it to a line.
+    doc["nodes"][0]["scale"] = {1.0, 0.0, 1.0};
+    EXPECT_NE(error_of([&] { load_gltf(write_file(dir, "line.gltf", doc.dump())); }).find("nothing visible"), std::string::npos);
+    // A model that grows from scale 0 (key times 0 and 1, scales 0 and 1) is visible later.
+    doc["nodes"][0]["scale"] = {0.0, 0.0, 0.0};
+    doc["buffers"].push_back({{"uri", "data:application/octet-stream;base64,AAAAAAAAgD8AAAAAAAAAAAAAAAAAAIA/AACAPwAAgD8="},
+                              {"byteLength", 32}});
+    doc["bufferViews"].push_back({{"buffer", 1}, {"byteLength", 8}});
+    doc["bufferViews"].push_back({{"buffer", 1}, {"byteOffset", 8}, {"byteLength", 24}});
+    doc["accessors"].push_back({{"bufferView", 1}, {"componentType", 5126}, {"count", 2}, {"type", "SCALAR"}, {"min", {0}}, {"max", {1}}});
+    doc["accessors"].push_back({{"bufferView", 2}, {"componentType", 5126}, {"count", 2}, {"type", "VEC3"}});
+    nlohmann::json animation;
+    animation["samplers"] = nlohmann::json::array({nlohmann::json{{"input", 1}, {"output", 2}}});
+    animation["channels"] =
+        nlohmann::json::array({nlohmann::json{{"sampler", 0}, {"target", {{"node", 0}, {"path", "scale"}}}}});
+    doc["animations"] = nlohmann::json::array({animation});
+    const Scene grows = load_gltf(write_file(dir, "grows.gltf", doc.dump()));
+    EXPECT_TRUE(grows.is_animated());
 }

@@ -134,6 +134,9 @@ TEST(HeadPoseTrace, ErrorsNameFileAndLine) {
     EXPECT_NE(error_of([&] { load_head_pose_trace(empty); }).find("no samples"), std::string::npos);
     std::string missing = error_of([] { load_head_pose_trace("/nonexistent/trace.csv"); });
     EXPECT_NE(missing.find("/nonexistent/trace.csv"), std::string::npos) << missing;
+    // /dev/zero read without end.
+    const std::string device = error_of([] { load_head_pose_trace("/dev/zero"); });
+    EXPECT_NE(device.find("/dev/zero: is a character device, not a regular file"), std::string::npos) << device;
 }
 
 TEST(HeadPoseTrace, SamplingInterpolatesAndClamps) {

@@ -49,6 +49,23 @@ TEST(PlyLoader, AsciiPlyRoundTrip) {
     check_pyramid(load_ply_or_off(write_file(dir, "pyramid.ply", kPyramidPly)));
 }
 
+TEST(PlyLoader, FreeTextHeaderLinesAreSkippedWithAWarning) {
+    // Exporters write lines such as "Created by ..." between the header keywords; other
+    // readers skip them, and so did gilab before the header was checked strictly.
+    std::string text = kPyramidPly;
+    text.insert(text.find("element vertex"), "Created by ExampleScanner 2.1\n");
+    text.insert(text.find("end_header"), "units mm\n");
+    auto dir = test::temp_dir("ply_free_text_header");
+    const Scene s = load_ply_or_off(write_file(dir, "annotated.ply", text));
+    check_pyramid(s);
+    std::vector<std::string> notes;
+    for (const std::string& w : s.warnings)
+        if (w.find("annotated.ply:4:") != std::string::npos || w.find("annotated.ply:11:") != std::string::npos) notes.push_back(w);
+    ASSERT_EQ(notes.size(), 2u) << "expected a warning for each free-text header line";
+    EXPECT_NE(notes[0].find("'Created'"), std::string::npos) << notes[0];
+    EXPECT_NE(notes[0].find("ignored"), std::string::npos) << notes[0];
+}
+
 TEST(PlyLoader, BinaryPlyRoundTrip) {
     auto dir = test::temp_dir("ply_binary");
     std::string bytes =

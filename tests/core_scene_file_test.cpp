@@ -252,6 +252,25 @@ TEST(SceneFile, WrongTypesAreErrorsWithTheirPath) {
     }
 }
 
+TEST(SceneFile, MessagesQuoteNumbersAsGiven) {
+    // std::to_string printed 1e-300 as 0.000000 and six digits rounded 1234.5678 away.
+    auto dir = fixture_dir("scene_numbers_as_given");
+    const std::string mesh = R"({"meshes": [{"file": "models/a.obj"}], )";
+    const std::pair<const char*, const char*> cases[] = {
+        {R"("animation": {"frames_per_second": 1e-300}})", "/animation/frames_per_second: 1e-300 is too small"},
+        {R"("animation": {"frames_per_second": -0.001}})", "expected a positive number, got -0.001"},
+        {R"("animation": {"frames_per_second": 1234.5678}})", "1234.5678 is out of range (0, 1000]"},
+        {R"("animation": {"frames_per_second": 1.2345678901234567e300}})", "1.2345678901234567e+300 is out of range"},
+    };
+    int i = 0;
+    for (const auto& [json, expected] : cases) {
+        auto p = write_file(dir, "numbers" + std::to_string(i++) + ".json", mesh + json);
+        const std::string msg = error_of([&] { load(p); });
+        EXPECT_NE(msg.find(expected), std::string::npos) << json << "\n  → " << msg;
+        EXPECT_EQ(msg.find("0.000000"), std::string::npos) << msg;
+    }
+}
+
 TEST(SceneFile, MissingMeshFileNamesPathAndSearchedDirectories) {
     auto dir = fixture_dir("scene_missing_mesh");
     auto p = write_file(dir, "x.json", R"({"meshes": [{"file": "models/a.obj"}, {"file": "foo.obj"}]})");

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 #include <cmath>
+#include "core/format.hpp"
 #include "core/settings.hpp"
 #include "tests/test_support.hpp"
 
@@ -79,4 +80,24 @@ TEST(Settings, HashIsStableAndSensitive) {
     Settings c(nlohmann::json{{"seed", 2}, {"spp", 4}});
     EXPECT_EQ(a.hash(), b.hash());
     EXPECT_NE(a.hash(), c.hash());
+}
+
+TEST(Settings, RangesInMessagesAreExact) {
+    // Six significant digits made the bounds of an int read "[-2.14748e+09, 2.14748e+09]".
+    Settings s(nlohmann::json{{"three_billion", 3000000000ull}}, "numbers");
+    const std::string msg = test::error_of([&] { s.get<int>("three_billion", 0); });
+    EXPECT_NE(msg.find("[-2147483648, 2147483647]"), std::string::npos) << msg;
+}
+
+TEST(NumberAsGiven, ShortestTextThatReadsBackExactly) {
+    EXPECT_EQ(number_as_given(1e-300), "1e-300");
+    EXPECT_EQ(number_as_given(0.1), "0.1");
+    EXPECT_EQ(number_as_given(1234.5678), "1234.5678");
+    EXPECT_EQ(number_as_given(-2.5), "-2.5");
+    EXPECT_EQ(number_as_given(1e12), "1e+12");
+    EXPECT_EQ(number_as_given(100.0), "100");
+    EXPECT_EQ(number_as_given(0.1f), "0.1");  // single precision: not 0.100000001
+    EXPECT_EQ(number_as_given(3.4028235e38f), "3.4028235e+38");
+    for (double v : {1e-300, 0.1, 1.0 / 3.0, 6.02214076e23, -1.7976931348623157e308})
+        EXPECT_EQ(std::stod(number_as_given(v)), v) << number_as_given(v);
 }

@@ -141,4 +141,6 @@ TEST(FireScene, BadOptionsAreErrors) {
     o = {};
     o.fps = 0;
     EXPECT_NE(gilab::test::error_of([&] { make_fire_scene(o); }).find("frames per second"), std::string::npos);
+    o.fps = -1e-300;  // quoted as given, not as -0.000000
+    EXPECT_NE(gilab::test::error_of([&] { make_fire_scene(o); }).find("not -1e-300"), std::string::npos);
 }
