@@ -61,6 +61,14 @@ struct Point {
     json mean_radius = nullptr;
 };
 
+// The photon pass prepare() made: only the fixed-radius photon map is traced and built
+// there (the progressive mode traces each iteration inside render(), the path tracer
+// traces no photons), so the others have none to charge.
+double photon_pass_ms(const Stats& prepared) {
+    if (!prepared.has("photon_trace_ms")) return 0;
+    return prepared.get("photon_trace_ms") + prepared.get("photon_build_ms");
+}
+
 // Renders one variant and measures it (see the file comment for what the time covers).
 Point measure(const Scene& scene, const EyeCamera& camera, const Film& reference, const std::string& technique,
               const json& settings_json) {
@@ -73,7 +81,7 @@ Point measure(const Scene& scene, const EyeCamera& camera, const Film& reference
     Stopwatch watch;
     t->render(ViewSet::mono(camera), films);
     Point p;
-    p.ms = watch.elapsed_ms() + prepared.get("photon_trace_ms") + prepared.get("photon_build_ms");
+    p.ms = watch.elapsed_ms() + photon_pass_ms(prepared);
     p.relmse = relative_mse(films.at(0), reference, "color");
     const Stats rendered = t->stats();
     if (technique == "photon") p.photons = rendered.get("photons_emitted");
