@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <tuple>
 #include <limits>
 #include <tbb/parallel_sort.h>
 #include "accel/anisotropic_voxelizer.hpp"
@@ -27,6 +28,7 @@
 #include "core/voxelizer.hpp"
 #include "experiments/experiment.hpp"
 #include "experiments/measures.hpp"
+#include "experiments/path_reference.hpp"
 #include "scenes/builtin_scenes.hpp"
 #include "scenes/scene_library.hpp"
 #include "techniques/technique.hpp"
@@ -283,12 +285,20 @@ SceneFigures measure_structures(const ExperimentContext& ctx, const Scene& scene
     return out;
 }
 
+// What a process-wide cache of measurements is keyed by: every input of the context that
+// changes the figures (quick sizes, the scene files found, the seed), so a second
+// run_experiment in the same process (Python) with other inputs measures again instead
+// of returning the first run's figures.
+using RunKey = std::tuple<bool, std::string, uint64_t>;
+RunKey run_key(const ExperimentContext& ctx) { return {ctx.quick, ctx.assets.describe(), ctx.seed}; }
+
 // Results are kept for the process, so Tables 1, 3 and 5 (and 2, 4, 6) share one run.
 const std::vector<SceneFigures>& structure_figures(const ExperimentContext& ctx, bool dynamic_scenes,
                                                    ExperimentOutput& out) {
-    static std::map<std::pair<bool, bool>, std::vector<SceneFigures>> cache;
-    static std::map<std::pair<bool, bool>, std::vector<std::string>> cached_notes;
-    auto key = std::make_pair(dynamic_scenes, ctx.quick);
+    using Key = std::pair<bool, RunKey>;
+    static std::map<Key, std::vector<SceneFigures>> cache;
+    static std::map<Key, std::vector<std::string>> cached_notes;
+    const Key key{dynamic_scenes, run_key(ctx)};
     auto it = cache.find(key);
     if (it == cache.end()) {
         std::vector<SceneFigures> figures;
@@ -546,15 +556,6 @@ Film render(Technique& t, const EyeCamera& camera) {
     return films.at(0);
 }
 
-Film path_reference(const ExperimentContext& ctx, const Scene& scene, const EyeCamera& camera, int spp) {
-    auto path = TechniqueRegistry::builtin().create("path");
-    Settings s(nlohmann::json{{"spp", spp}, {"seed", ctx.seed}, {"max_depth", 8}, {"jitter", false}}, "vct reference");
-    path->prepare(scene, s);
-    s.report_unused();
-    ctx.say("path-traced reference " + std::to_string(camera.width()) + "², " + std::to_string(spp) + " spp ...");
-    return render(*path, camera);
-}
-
 void save_images(const ExperimentContext& ctx, ExperimentOutput& out, const std::string& name, const Film& film) {
     write_exr(ctx.output_dir / (name + ".exr"), film);
     write_png(ctx.output_dir / (name + ".png"), film);
@@ -690,8 +691,9 @@ struct WalkRuns {
 // One walk per scene, shared by Figs. 9 and 10; scenes whose mesh is missing are skipped
 // with a note.
 const std::vector<WalkRuns>& path_runs(const ExperimentContext& ctx, ExperimentOutput& out) {
-    static std::map<bool, std::pair<std::vector<WalkRuns>, std::vector<std::string>>> cache;
-    auto it = cache.find(ctx.quick);
+    static std::map<RunKey, std::pair<std::vector<WalkRuns>, std::vector<std::string>>> cache;
+    const RunKey key = run_key(ctx);
+    auto it = cache.find(key);
     if (it == cache.end()) {
         std::vector<WalkRuns> all;
         ExperimentOutput scratch;
@@ -750,7 +752,7 @@ const std::vector<WalkRuns>& path_runs(const ExperimentContext& ctx, ExperimentO
                 ctx.say(walk.scene + ", " + r.name + ": mean frame " + std::to_string(mean(r.total_ms)) + " ms");
             all.push_back(std::move(w));
         }
-        it = cache.emplace(ctx.quick, std::make_pair(std::move(all), scratch.notes)).first;
+        it = cache.emplace(key, std::make_pair(std::move(all), scratch.notes)).first;
     }
     for (const std::string& n : it->second.second) out.notes.push_back(n);
     if (it->second.first.empty()) throw Error("vct experiments", "no walk scene could be loaded");
@@ -883,8 +885,8 @@ ExperimentOutput run_fig11(const ExperimentContext& ctx) {
     quick_note(ctx, out);
     RenderSetup s = sponza_setup(ctx, false);
     const int spp = ctx.quick ? 32 : 512;
-    Film reference = path_reference(ctx, s.scene, s.camera, spp);
-    save_images(ctx, out, "sponza_path_reference", reference);
+    // The shared, cached reference: its own seed, so it shares no samples with the run.
+    Film reference = path_reference(ctx, s.scene, s.camera, spp, out.files);
     ResultTable t;
     t.title = "Fig. 11 — Sponza: cone-traced images against a path-traced reference";
     t.columns = {"image", "relmse_color", "relmse_indirect", "mean_color", "mean_indirect", "frame_ms"};
@@ -1042,8 +1044,8 @@ ExperimentOutput run_stability(const ExperimentContext& ctx) {
     leak.title = "Light leaking — mean radiance seen in the dark room (camera in room B, lamp in room A)";
     leak.columns = {"technique", "dark_room_mean", "lit_room_mean", "leak_ratio"};
     {
-        Film dark = path_reference(ctx, rooms, dark_cam, ctx.quick ? 16 : 64);
-        Film lit = path_reference(ctx, rooms, lit_cam, ctx.quick ? 16 : 64);
+        Film dark = path_reference(ctx, rooms, dark_cam, ctx.quick ? 16 : 64, out.files);
+        Film lit = path_reference(ctx, rooms, lit_cam, ctx.quick ? 16 : 64, out.files);
         leak.rows.push_back({{"technique", "path tracer"}, {"dark_room_mean", mean_value(dark)}, {"lit_room_mean", mean_value(lit)},
                              {"leak_ratio", mean_value(dark) / std::max(mean_value(lit), 1e-12)}});
     }
