@@ -64,6 +64,13 @@ TEST_F(VctExperiments, MemoryChargesEachStructureItsRealEncodingInMegabytesOfTen
         const double per_node = row.at("bytes per node or cell").get<double>();
         EXPECT_NEAR(memory, count * per_node, 1e-9 * memory) << row.dump();
         EXPECT_LE(memory, row.at("all arrays held (MB)").get<double>() * (1 + 1e-12)) << row.dump();
+        // The paper's accounting, 1 B per voxel face, applied to every structure alike.
+        const double paper_accounting =
+            row.at("memory, paper's accounting: 1 B per face × 6 faces per node or cell (MB)").get<double>();
+        EXPECT_NEAR(paper_accounting, 6 * count, 1e-9 * paper_accounting) << row.dump();
+        if (structure == "cascaded") {
+            EXPECT_DOUBLE_EQ(paper_accounting, (std::log2(n / 32.0) + 1) * 32 * 32 * 32 * 6 / 1e6) << row.dump();
+        }
         const std::string fixed = row.at("fixed by construction").get<std::string>();
         EXPECT_EQ(fixed.rfind("yes", 0) == 0, structure == "3D texture" || structure == "cascaded") << row.dump();
         if (structure == "3D texture") {
