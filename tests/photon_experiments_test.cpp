@@ -34,6 +34,37 @@ TEST_P(PhotonQuickExperiment, RunsAndFillsEveryColumn) {
 INSTANTIATE_TEST_SUITE_P(All, PhotonQuickExperiment,
                          testing::Values("pm-fig8", "pm-table5", "pm-final", "pm-foveated"), test::test_name_of);
 
+// pm-foveated: the fovea and periphery figures of each angle come with the unfoveated
+// render's figures over the same masks; the 'off' row has no mask, so it leaves them
+// empty instead of printing its whole-image error as a periphery error.
+TEST(PhotonFoveated, EachMaskedErrorHasTheUnfoveatedErrorOverTheSameMask) {
+    const ExperimentOutput out = test::run_quick_experiment(photon_registry(), "pm-foveated");
+    std::map<std::string, double> whole_unfoveated;  // scene → the off row's whole-image relMSE
+    int angled = 0;
+    for (const json& row : out.tables.at(0).rows) {
+        const std::string scene = row.at("scene");
+        const double whole = row.at("relmse_vs_path (whole image)").get<double>();
+        EXPECT_GT(whole, 0.0) << row.dump();
+        if (row.at("fovea_angle") == "off") {
+            EXPECT_TRUE(row.at("relmse_periphery_vs_path").is_null()) << row.dump();
+            EXPECT_TRUE(row.at("relmse_fovea_vs_path").is_null()) << row.dump();
+            whole_unfoveated[scene] = whole;
+            continue;
+        }
+        ASSERT_TRUE(whole_unfoveated.count(scene)) << "the off row comes first: " << row.dump();
+        const double fovea = row.at("unfoveated relmse_fovea_vs_path (same mask)").get<double>();
+        const double periphery = row.at("unfoveated relmse_periphery_vs_path (same mask)").get<double>();
+        const double share = row.at("fovea_pixels").get<double>();
+        ASSERT_GT(share, 0.0) << row.dump();
+        ASSERT_LT(share, 1.0) << row.dump();
+        // The two masks split the image: their pixel-weighted mean is the whole image's.
+        EXPECT_NEAR(share * fovea + (1 - share) * periphery, whole_unfoveated[scene], 1e-6 * whole_unfoveated[scene])
+            << row.dump();
+        ++angled;
+    }
+    EXPECT_GE(angled, 3);
+}
+
 // P1 Tables 1–4 (ms): (photons, radius, variant) → published frame time.
 using Key = std::tuple<std::string, double, std::string>;
 const std::map<Key, double>& published_ms() {
