@@ -48,9 +48,9 @@ struct Sizes {
 };
 
 Sizes sizes_for(bool quick) {
-    // A reference's noise should be at most a tenth of the smallest error it judges: the
-    // path tracer's at its most spp, whose variance is that of a reference with 1/spp as
-    // many samples, so a reference needs more than 10 × its spp (2 × 8192 ≥ 16 × 1024).
+    // A reference's noise should be at most a tenth of the smallest error it judges,
+    // usually the path tracer's at its most spp: that error is the variance of spp
+    // samples, so the reference needs more than 10 × those spp (2 × 8192 ≥ 16 × 1024).
     // The conference room's fireflies make its noise fall more slowly than that: at 1024
     // spp every variant levelled off at relMSE 0.014–0.018, its reference's noise; in
     // quick runs 2 × 512 spp left a noise of 0.0066 under errors from 0.017.
