@@ -286,11 +286,11 @@ SceneFigures measure_structures(const ExperimentContext& ctx, const Scene& scene
 }
 
 // What a process-wide cache of measurements is keyed by: every input of the context that
-// changes the figures (quick sizes, the scene files found, the seed), so a second
-// run_experiment in the same process (Python) with other inputs measures again instead
-// of returning the first run's figures.
-using RunKey = std::tuple<bool, std::string, uint64_t>;
-RunKey run_key(const ExperimentContext& ctx) { return {ctx.quick, ctx.assets.describe(), ctx.seed}; }
+// changes the figures (quick sizes, the scene files found, the seed, and the thread count
+// the times were taken at), so a second run_experiment in the same process (Python) with
+// other inputs measures again instead of returning the first run's figures.
+using RunKey = std::tuple<bool, std::string, uint64_t, int>;
+RunKey run_key(const ExperimentContext& ctx) { return {ctx.quick, ctx.assets.describe(), ctx.seed, ctx.threads}; }
 
 // Results are kept for the process, so Tables 1, 3 and 5 (and 2, 4, 6) share one run.
 const std::vector<SceneFigures>& structure_figures(const ExperimentContext& ctx, bool dynamic_scenes,
