@@ -1,5 +1,7 @@
 #include "core/stats.hpp"
 
+#include "core/error.hpp"
+
 #include <malloc.h>
 #include <unistd.h>
 #include <fstream>
@@ -7,7 +9,15 @@
 
 namespace gilab {
 
-double Stats::get(const std::string& key, double fallback) const {
+double Stats::get(const std::string& key) const {
+    auto it = values_.find(key);
+    if (it != values_.end()) return it->second;
+    std::string present;
+    for (const auto& [k, v] : values_) present += (present.empty() ? "" : ", ") + k;
+    throw Error("stats", "no figure '" + key + "' (present: " + (present.empty() ? "none" : present) + ")");
+}
+
+double Stats::get_or(const std::string& key, double fallback) const {
     auto it = values_.find(key);
     return it == values_.end() ? fallback : it->second;
 }

@@ -12,7 +12,12 @@ class Stats {
 public:
     void set(const std::string& key, double value) { values_[key] = value; }
     void add(const std::string& key, double value) { values_[key] += value; }
-    double get(const std::string& key, double fallback = 0) const;
+    // The figure under key; throws Error naming the key and the keys present when it is
+    // missing, so a mistyped or never-set key cannot print as a plausible 0.
+    double get(const std::string& key) const;
+    // The figure under key, or fallback when it was never set: only where "not set" truly
+    // means that value (e.g. a counter of work this frame did not do).
+    double get_or(const std::string& key, double fallback) const;
     bool has(const std::string& key) const { return values_.count(key) != 0; }
     const std::map<std::string, double>& values() const { return values_; }
     void merge(const Stats& other, const std::string& prefix = "");

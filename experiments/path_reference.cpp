@@ -14,8 +14,9 @@ namespace fs = std::filesystem;
 uint64_t reference_seed(uint64_t run_seed) { return run_seed ^ 0x5245464552454eull; }
 
 Film path_reference(const ExperimentContext& ctx, const Scene& scene, const EyeCamera& camera, int spp,
-                     std::vector<std::string>& files, bool jitter) {
-    nlohmann::json settings = {{"spp", spp}, {"seed", reference_seed(ctx.seed)}, {"max_depth", 8}, {"jitter", jitter}};
+                     std::vector<std::string>& files, bool jitter, std::optional<uint64_t> seed) {
+    nlohmann::json settings = {
+        {"spp", spp}, {"seed", seed.value_or(reference_seed(ctx.seed))}, {"max_depth", 8}, {"jitter", jitter}};
     // The key: the scene's content, every setting given to the path tracer (the rest are
     // its defaults, which are part of its code), the digest of the path tracer's code,
     // and the camera.

@@ -4,6 +4,7 @@
 // copied from a sibling pm-* directory that already rendered it) under a name that holds
 // a digest of the scene's content, the path tracer's settings and code, and the camera.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 #include "core/camera.hpp"
@@ -21,7 +22,9 @@ uint64_t reference_seed(uint64_t run_seed);
 
 // Adds the reference's file name to `files`. `jitter` spreads each pixel's samples over
 // its area (an anti-aliased reference, for techniques that sample pixels the same way).
+// `seed` replaces reference_seed(ctx.seed), e.g. for a second, independent reference
+// whose difference from the first estimates their noise; it is part of the cache key.
 Film path_reference(const ExperimentContext& ctx, const Scene& scene, const EyeCamera& camera, int spp,
-                    std::vector<std::string>& files, bool jitter = false);
+                    std::vector<std::string>& files, bool jitter = false, std::optional<uint64_t> seed = {});
 
 }  // namespace gilab

@@ -4,9 +4,12 @@
 // one run at one thread count. Error is the relative MSE of the color layer against a
 // jittered path-traced reference with many samples; wall time is what each variant spends
 // making its image once the scene's ray-tracing structure exists (photon tracing and map
-// building included), so the scene load, the same for all, is left out.
+// building included), so the scene load, the same for all, is left out. The reference is
+// the mean of two path-traced halves on independent seeds; their difference estimates
+// the noise it adds to every error, and errors below that estimate are left blank.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <sstream>
 #include "core/error.hpp"
@@ -35,7 +38,7 @@ constexpr double kCornellRadius = 0.05;
 
 struct Sizes {
     int size;                           // image side, pixels
-    int reference_spp;                  // per scene below; the conference room's is lower
+    int reference_spp;                  // per half of the reference, per scene below
     int conference_reference_spp;
     std::vector<int> fixed_photons;     // (a) photons emitted, fixed radius
     int fixed_spp;
@@ -45,8 +48,14 @@ struct Sizes {
 };
 
 Sizes sizes_for(bool quick) {
-    if (quick) return {48, 1024, 512, {4096, 16384}, 4, {2, 8, 32}, 4096, {4, 16, 64}};
-    return {256, 4096, 1024, {16384, 65536, 262144, 1048576}, 16, {4, 16, 64, 256}, 16384, {16, 64, 256, 1024}};
+    // A reference's noise should be at most a tenth of the smallest error it judges,
+    // usually the path tracer's at its most spp: that error is the variance of spp
+    // samples, so the reference needs more than 10 × those spp (2 × 8192 ≥ 16 × 1024).
+    // The conference room's fireflies make its noise fall more slowly than that: at 1024
+    // spp every variant levelled off at relMSE 0.014–0.018, its reference's noise; in
+    // quick runs 2 × 512 spp left a noise of 0.0066 under errors from 0.017.
+    if (quick) return {48, 1024, 4096, {4096, 16384}, 4, {2, 8, 32}, 4096, {4, 16, 64}};
+    return {256, 8192, 8192, {16384, 65536, 262144, 1048576}, 16, {4, 16, 64, 256}, 16384, {16, 64, 256, 1024}};
 }
 
 double diagonal(const Scene& scene) {
@@ -57,9 +66,18 @@ double diagonal(const Scene& scene) {
 struct Point {
     std::string variant, setting;
     double ms = 0, relmse = 0;
+    bool below_noise = false;  // relmse is under the reference's noise: not a measurement
     json photons = nullptr;
     json mean_radius = nullptr;
 };
+
+// The photon pass prepare() made: only the fixed-radius photon map is traced and built
+// there (the progressive mode traces each iteration inside render(), the path tracer
+// traces no photons), so the others have none to charge.
+double photon_pass_ms(const Stats& prepared) {
+    if (!prepared.has("photon_trace_ms")) return 0;
+    return prepared.get("photon_trace_ms") + prepared.get("photon_build_ms");
+}
 
 // Renders one variant and measures it (see the file comment for what the time covers).
 Point measure(const Scene& scene, const EyeCamera& camera, const Film& reference, const std::string& technique,
@@ -73,12 +91,42 @@ Point measure(const Scene& scene, const EyeCamera& camera, const Film& reference
     Stopwatch watch;
     t->render(ViewSet::mono(camera), films);
     Point p;
-    p.ms = watch.elapsed_ms() + prepared.get("photon_trace_ms") + prepared.get("photon_build_ms");
+    p.ms = watch.elapsed_ms() + photon_pass_ms(prepared);
     p.relmse = relative_mse(films.at(0), reference, "color");
     const Stats rendered = t->stats();
     if (technique == "photon") p.photons = rendered.get("photons_emitted");
     if (settings_json.value("progressive", false)) p.mean_radius = rendered.get("mean_final_radius");
     return p;
+}
+
+// A reference and the noise it adds to every relMSE measured against it.
+struct NoisyReference {
+    Film image;    // the mean of the two halves
+    double noise;  // estimated relMSE of `image` against the noise-free image
+    int spp;       // both halves together
+};
+
+// The second half's seed: independent of the first half's and of the run's.
+uint64_t second_half_seed(uint64_t run_seed) { return reference_seed(run_seed) ^ 0x48414c46ull; }
+
+// Two path-traced references A and B on independent seeds (each cached like every
+// reference), averaged: R = (A + B) / 2. A pixel's error of R has variance σ²/2 where σ²
+// is one half's, and E[((A − B) / 2)²] = σ²/2 too, so the relMSE of R + (A − B) / 2
+// against R estimates the relMSE R's own noise adds to any error measured against it.
+NoisyReference noisy_reference(const ExperimentContext& ctx, const Scene& scene, const EyeCamera& camera,
+                               int spp_per_half, std::vector<std::string>& files) {
+    const Film a = path_reference(ctx, scene, camera, spp_per_half, files, /*jitter=*/true);
+    const Film b = path_reference(ctx, scene, camera, spp_per_half, files, /*jitter=*/true, second_half_seed(ctx.seed));
+    Film mean(a.width(), a.height()), off_by_noise(a.width(), a.height());
+    const auto& da = a.layer("color").data;
+    const auto& db = b.layer("color").data;
+    auto& m = mean.layer("color").data;
+    auto& o = off_by_noise.layer("color").data;
+    for (size_t i = 0; i < da.size(); ++i) {
+        m[i] = 0.5f * (da[i] + db[i]);
+        o[i] = m[i] + 0.5f * (da[i] - db[i]);
+    }
+    return {mean, relative_mse(off_by_noise, mean, "color"), 2 * spp_per_half};
 }
 
 // The time at which a curve first reaches `target`, interpolated between the measured
@@ -102,6 +150,21 @@ std::string target_column(double target) {
     return s.str();
 }
 
+// The least-squares slope of log relMSE against log count (photons, iterations, spp)
+// over the measured points above the reference's noise; null with fewer than two.
+json log_log_slope(const std::vector<Point>& curve, const std::map<std::string, double>& count_of) {
+    double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (const Point& p : curve) {
+        if (p.below_noise) continue;
+        const double x = std::log(count_of.at(p.setting)), y = std::log(p.relmse);
+        n += 1, sx += x, sy += y, sxx += x * x, sxy += x * y;
+    }
+    if (n < 2) return nullptr;
+    return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+std::string noise_floor_text(double noise) { return "below the reference's noise (" + format_number(noise) + ")"; }
+
 ExperimentOutput run(const ExperimentContext& ctx) {
     ExperimentOutput out;
     const Sizes z = sizes_for(ctx.quick);
@@ -120,13 +183,15 @@ ExperimentOutput run(const ExperimentContext& ctx) {
     }
     const double cornell_diagonal = diagonal(scenes.front().scene);
 
-    ResultTable table{"relMSE (color) against a path-traced reference vs wall time",
-                      {"scene", "variant", "setting", "wall ms", "relMSE", "photons emitted", "mean final radius"},
+    ResultTable table{"relMSE (color) against a path-traced reference vs wall time (blank: below the reference's noise)",
+                      {"scene", "variant", "setting", "wall ms", "relMSE", "reference noise (relMSE)", "photons emitted",
+                       "mean final radius"},
                       {}};
     ResultTable reach{"Time to reach a relMSE (interpolated in log–log between measured points)",
                       {"scene", "variant"},
                       {}};
     for (double target : kTargets) reach.columns.push_back(target_column(target));
+    reach.columns.push_back("log–log slope of relMSE vs count (photons, iterations or spp)");
     json scene_config = json::object();
 
     for (const Named& named : scenes) {
@@ -134,21 +199,30 @@ ExperimentOutput run(const ExperimentContext& ctx) {
         if (!scene.camera) throw Error("pm-convergence", named.name + " has no camera");
         const SceneCamera& c = *scene.camera;
         const EyeCamera camera = EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, z.size, z.size);
-        const Film reference = path_reference(ctx, scene, camera, named.reference_spp, out.files, /*jitter=*/true);
+        const NoisyReference ref = noisy_reference(ctx, scene, camera, named.reference_spp, out.files);
+        const Film& reference = ref.image;
         const double radius = kCornellRadius * diagonal(scene) / cornell_diagonal;
-        scene_config[named.name] = {{"resolution", {z.size, z.size}}, {"reference_spp", named.reference_spp},
-                                    {"radius", radius}};
-        out.notes.push_back(named.name + ": reference = path tracer, " + std::to_string(named.reference_spp) +
-                            " jittered spp at " + std::to_string(z.size) + "², max depth 8, on a seed of its own (no variant "
-                            "shares its samples); its own noise is a floor under every measured relMSE.");
+        scene_config[named.name] = {{"resolution", {z.size, z.size}}, {"reference_spp", ref.spp},
+                                    {"reference_noise_relmse", ref.noise}, {"radius", radius}};
+        out.notes.push_back(named.name + ": reference = path tracer, two halves of " + std::to_string(named.reference_spp) +
+                            " jittered spp on independent seeds of their own (no variant shares their samples), "
+                            "averaged (" + std::to_string(ref.spp) + " spp), at " + std::to_string(z.size) +
+                            "², max depth 8. Its noise, estimated from the halves, is relMSE " + format_number(ref.noise) +
+                            ": a floor under every error measured against it.");
 
         std::map<std::string, std::vector<Point>> curves;
-        auto record = [&](Point p) {
+        std::map<std::string, double> count_of;  // setting → photons, iterations or spp
+        double smallest_reported = std::numeric_limits<double>::infinity();
+        auto record = [&](Point p, double count) {
+            p.below_noise = p.relmse < ref.noise;
+            if (!p.below_noise) smallest_reported = std::min(smallest_reported, p.relmse);
             ctx.say(named.name + " " + p.variant + " " + p.setting + ": " + format_number(p.ms) + " ms, relMSE " +
-                    format_number(p.relmse));
+                    format_number(p.relmse) + (p.below_noise ? " (below the reference's noise)" : ""));
             table.rows.push_back({{"scene", named.name}, {"variant", p.variant}, {"setting", p.setting},
-                                  {"wall ms", p.ms}, {"relMSE", p.relmse}, {"photons emitted", p.photons},
+                                  {"wall ms", p.ms}, {"relMSE", p.below_noise ? json() : json(p.relmse)},
+                                  {"reference noise (relMSE)", ref.noise}, {"photons emitted", p.photons},
                                   {"mean final radius", p.mean_radius}});
+            count_of[p.setting] = count;
             curves[p.variant].push_back(p);
         };
         const std::string fixed = "photon r fixed, spp " + std::to_string(z.fixed_spp);
@@ -156,7 +230,7 @@ ExperimentOutput run(const ExperimentContext& ctx) {
             Point p = measure(scene, camera, reference, "photon",
                               {{"photons", photons}, {"radius", radius}, {"spp", z.fixed_spp}, {"seed", ctx.seed}});
             p.variant = fixed, p.setting = std::to_string(photons) + " photons";
-            record(p);
+            record(p, photons);
         }
         const std::string progressive = "photon progressive";
         for (int iterations : z.iterations) {
@@ -164,13 +238,13 @@ ExperimentOutput run(const ExperimentContext& ctx) {
                               {{"progressive", true}, {"iterations", iterations}, {"photons", z.photons_per_iteration},
                                {"radius", radius}, {"seed", ctx.seed}});
             p.variant = progressive, p.setting = std::to_string(iterations) + " iterations";
-            record(p);
+            record(p, iterations);
         }
         const std::string path = "path";
         for (int spp : z.path_spp) {
             Point p = measure(scene, camera, reference, "path", {{"spp", spp}, {"seed", ctx.seed}, {"max_depth", 8}});
             p.variant = path, p.setting = std::to_string(spp) + " spp";
-            record(p);
+            record(p, spp);
         }
 
         Plot plot;
@@ -184,12 +258,22 @@ ExperimentOutput run(const ExperimentContext& ctx) {
             json row = {{"scene", named.name}, {"variant", variant}};
             std::vector<Point> curve = curves[variant];
             std::sort(curve.begin(), curve.end(), [](const Point& a, const Point& b) { return a.ms < b.ms; });
-            for (const Point& p : curve) series.x.push_back(p.ms), series.y.push_back(p.relmse);
-            for (double target : kTargets) row[target_column(target)] = time_to_reach(curve, target);
+            for (const Point& p : curve)
+                if (!p.below_noise) series.x.push_back(p.ms), series.y.push_back(p.relmse);
+            for (double target : kTargets)
+                row[target_column(target)] = target < ref.noise ? json(noise_floor_text(ref.noise)) : time_to_reach(curve, target);
+            row["log–log slope of relMSE vs count (photons, iterations or spp)"] = log_log_slope(curve, count_of);
             reach.rows.push_back(row);
             plot.series.push_back(series);
         }
         out.plots.push_back({"convergence_" + named.name, plot});
+        // The reference should add at most a tenth of the smallest error reported.
+        if (std::isfinite(smallest_reported) && ref.noise > 0.1 * smallest_reported)
+            out.notes.push_back(named.name + ": the reference's noise (" + format_number(ref.noise) +
+                                ") is more than a tenth of the smallest error reported (" +
+                                format_number(smallest_reported) + "); a quieter reference needs about " +
+                                format_number(std::ceil(ref.noise / (0.1 * smallest_reported))) +
+                                "× its samples, more than this run spends on it.");
     }
     out.tables.push_back(table);
     out.tables.push_back(reach);
@@ -206,7 +290,12 @@ ExperimentOutput run(const ExperimentContext& ctx) {
                         "building in prepare(); the scene's ray-tracing structure (built by every technique alike) is "
                         "left out. One run per point, at the run's thread count.");
     out.notes.push_back("Time to reach: the first crossing of the target on the measured curve; \"≤ t (first "
-                        "point)\" when the cheapest point is already below it, \"not reached\" when no point is.");
+                        "point)\" when the cheapest point is already below it, \"not reached\" when no point is, "
+                        "\"below the reference's noise\" when the target is.");
+    out.notes.push_back("Reference noise = mean over pixels and channels of ((A − B)/2)² / (R² + 0.01) for the halves "
+                        "A, B and R = (A + B)/2: the expected relMSE R's own noise adds to an error. relMSE cells "
+                        "below it are left blank (and out of the plots and slopes): they measure the reference. The "
+                        "slope is the least-squares slope of log relMSE against log photons, iterations or spp.");
     return out;
 }
 

@@ -353,7 +353,9 @@ ExperimentOutput run_foveated(const ExperimentContext& ctx) {
     t.title = "Foveated gather: left eye, time vs error inside and outside the fovea";
     t.columns = {"scene",          "fovea_angle",        "frame_ms",           "speedup",
                  "gather_fraction", "fovea_pixels",      "relmse_fovea_vs_full", "relmse_periphery_vs_full",
-                 "relmse_fovea_vs_path", "relmse_periphery_vs_path"};
+                 "relmse_fovea_vs_path", "relmse_periphery_vs_path",
+                 "unfoveated relmse_fovea_vs_path (same mask)", "unfoveated relmse_periphery_vs_path (same mask)",
+                 "relmse_vs_path (whole image)"};
     for (const NamedScene& named : p1_scenes(ctx, out)) {
         const HmdRig rig = vive_rig(named.scene, ctx.quick);
         const EyeCamera eye = rig.eye(Eye::Left);
@@ -374,20 +376,28 @@ ExperimentOutput run_foveated(const ExperimentContext& ctx) {
             r["frame_ms"] = run.stats.get("render_ms");
             r["speedup"] = runs[0].stats.get("render_ms") / run.stats.get("render_ms");
             r["gather_fraction"] = run.stats.get("gather_queries") / pixels;
+            r["relmse_vs_path (whole image)"] = relative_mse(run.films[0], reference);
             if (angle) {
                 const std::vector<uint8_t> inside = fovea_mask(eye, a, true);
                 const std::vector<uint8_t> outside = fovea_mask(eye, a, false);
+                const Film& unfoveated = runs[0].films[0];
                 r["fovea_pixels"] = double(std::count(inside.begin(), inside.end(), 1)) / pixels;
-                r["relmse_fovea_vs_full"] = relative_mse_masked(run.films[0], runs[0].films[0], inside);
-                r["relmse_periphery_vs_full"] = relative_mse_masked(run.films[0], runs[0].films[0], outside);
+                r["relmse_fovea_vs_full"] = relative_mse_masked(run.films[0], unfoveated, inside);
+                r["relmse_periphery_vs_full"] = relative_mse_masked(run.films[0], unfoveated, outside);
                 r["relmse_fovea_vs_path"] = relative_mse_masked(run.films[0], reference, inside);
                 r["relmse_periphery_vs_path"] = relative_mse_masked(run.films[0], reference, outside);
+                // The unfoveated render over this row's own masks: the baseline each
+                // fovea and periphery figure is to be read against.
+                r["unfoveated relmse_fovea_vs_path (same mask)"] = relative_mse_masked(unfoveated, reference, inside);
+                r["unfoveated relmse_periphery_vs_path (same mask)"] = relative_mse_masked(unfoveated, reference, outside);
             } else {
-                r["fovea_pixels"] = 1.0;
-                r["relmse_fovea_vs_full"] = 0.0;
-                r["relmse_periphery_vs_full"] = 0.0;
-                r["relmse_fovea_vs_path"] = relative_mse(run.films[0], reference);
-                r["relmse_periphery_vs_path"] = relative_mse(run.films[0], reference);
+                // No fovea without an angle: the masked figures are in each angle's row
+                // (the unfoveated columns), not here over the whole image.
+                for (const char* masked : {"fovea_pixels", "relmse_fovea_vs_full", "relmse_periphery_vs_full",
+                                           "relmse_fovea_vs_path", "relmse_periphery_vs_path",
+                                           "unfoveated relmse_fovea_vs_path (same mask)",
+                                           "unfoveated relmse_periphery_vs_path (same mask)"})
+                    r[masked] = nullptr;
             }
             t.rows.push_back(r);
         };
@@ -410,7 +420,10 @@ ExperimentOutput run_foveated(const ExperimentContext& ctx) {
     out.notes.push_back("fovea = pixels of full-rate blocks (fovea_pixels: their share); gather_fraction = photon "
                         "gathers ÷ pixels. *_vs_full compares with the unfoveated render of the same seed (the fovea "
                         "is identical by construction, so its figure is 0); *_vs_path with the path-traced "
-                        "reference, the error a viewer would see.");
+                        "reference, the error a viewer would see. The 'unfoveated … (same mask)' columns give the "
+                        "unfoveated render's error over the same fovea and periphery pixels as the row's, so each "
+                        "masked figure has its baseline beside it; the 'off' row leaves the masked columns empty "
+                        "(its whole-image error is in 'relmse_vs_path (whole image)').");
     return out;
 }
 

@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 #include <string>
+#include "core/error.hpp"
 #include "experiments/experiment.hpp"
 #include "tests/experiment_test_support.hpp"
 
@@ -63,6 +64,13 @@ TEST_F(VctExperiments, MemoryChargesEachStructureItsRealEncodingInMegabytesOfTen
         const double per_node = row.at("bytes per node or cell").get<double>();
         EXPECT_NEAR(memory, count * per_node, 1e-9 * memory) << row.dump();
         EXPECT_LE(memory, row.at("all arrays held (MB)").get<double>() * (1 + 1e-12)) << row.dump();
+        // The paper's accounting, 1 B per voxel face, applied to every structure alike.
+        const double paper_accounting =
+            row.at("memory, paper's accounting: 1 B per face × 6 faces per node or cell (MB)").get<double>();
+        EXPECT_NEAR(paper_accounting, 6 * count, 1e-9 * paper_accounting) << row.dump();
+        if (structure == "cascaded") {
+            EXPECT_DOUBLE_EQ(paper_accounting, (std::log2(n / 32.0) + 1) * 32 * 32 * 32 * 6 / 1e6) << row.dump();
+        }
         const std::string fixed = row.at("fixed by construction").get<std::string>();
         EXPECT_EQ(fixed.rfind("yes", 0) == 0, structure == "3D texture" || structure == "cascaded") << row.dump();
         if (structure == "3D texture") {
@@ -166,6 +174,49 @@ TEST_F(VctExperiments, SibenikStandsBesideSponzaAndTheWalkHasThePhotonCurve) {
             }
         }
     }
+}
+
+}  // namespace
+
+namespace {
+
+using namespace gilab;
+using nlohmann::json;
+
+ExperimentOutput run_quick(const std::string& name, uint64_t seed, const AssetPaths& assets) {
+    ExperimentContext ctx;
+    ctx.quick = true;
+    ctx.seed = seed;
+    ctx.assets = assets;
+    ctx.output_dir = test::temp_dir("vct_cache_" + name + "_" + std::to_string(seed));
+    return run_and_write(vct_registry().get(name), ctx);
+}
+
+double photon_map_mb(const ExperimentOutput& fig10, const std::string& scene) {
+    for (const json& row : fig10.tables.back().rows)
+        if (row.at("scene") == scene && row.at("variant") == "photon mapping")
+            return row.at("mean structure (MB)").get<double>();
+    ADD_FAILURE() << "no photon mapping row for " << scene;
+    return 0;
+}
+
+// The structure tables keep their measurements for the process (Tables 1, 3, 5 share one
+// run); a second run whose scene files are not there must not print the first run's.
+TEST_F(VctExperiments, ASecondRunWithOtherAssetsDoesNotReturnTheFirstRunsFigures) {
+    (void)run_quick("vct-table1", 1, AssetPaths::from_environment());
+    const AssetPaths empty({test::temp_dir("vct_cache_no_assets")});
+    EXPECT_THROW((void)run_quick("vct-table1", 1, empty), Error);
+}
+
+// The walks of Figs. 9–10 are kept for the process too; the photon map holds the photons
+// a seed stores, so a second seed must give that seed's memory, the same seed the same.
+TEST_F(VctExperiments, ASecondRunWithAnotherSeedGivesItsOwnFigures) {
+    const AssetPaths assets = AssetPaths::from_environment();
+    const double first = photon_map_mb(run_quick("vct-fig10", 11, assets), "sponza");
+    const double second = photon_map_mb(run_quick("vct-fig10", 12, assets), "sponza");
+    const double first_again = photon_map_mb(run_quick("vct-fig10", 11, assets), "sponza");
+    EXPECT_NE(first, second);
+    EXPECT_EQ(first, first_again);
 }
 
 }  // namespace

@@ -118,7 +118,9 @@ void DagShadowsTechnique::build_structure() {
     const PunctualLight& l = light();
     Stopwatch watch;
     switch (settings_.visibility) {
-        case VisibilitySource::Ray: break;
+        case VisibilitySource::Ray:
+            structure_stats_.set("structure_bytes", 0);  // shadow rays: no structure is held
+            break;
         case VisibilitySource::ShadowMap:
             map_ = std::make_unique<ShadowMap>(
                 ShadowMap::build(scene_.tracer(), l, settings_.resolution, settings_.shadow_map_bits));

@@ -133,7 +133,8 @@ void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& fil
     }
     double ms = watch.elapsed_ms();
     for (Film& film : films) film.metadata["render_time_seconds"] = format_number(ms / 1000.0);
-    // Per-frame figures replace the previous frame's.
+    // Per-frame figures replace the previous frame's. A figure this frame's path did not
+    // produce (no stereo reuse, no tile sharing, ...) is work not done: 0 this frame.
     for (const char* key : {"fused_ms", "trace_pass_ms", "sort_ms", "gather_pass_ms", "nonfinite_pixels", "tile_groups",
                             "tile_grouped_hits", "tile_fetched_photons", "share_tiles_qualified",
                             "share_tiles_mixed", "left_ms", "right_ms",
@@ -141,7 +142,7 @@ void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& fil
                             "reuse_occluded", "reuse_candidates", "reuse_claimed_pixels", "reuse_depth_conflicts",
                             "reuse_strict_rejected", "reused_pixels", "reuse_crack_filled", "reuse_fraction", "reuse_reshaded_glossy",
                             "right_shaded_pixels"})
-        stats_.set(key, frame.get(key));
+        stats_.set(key, frame.get_or(key, 0));
     stats_.set("render_ms", ms);
     stats_.set("spp", double(settings_.sampling.spp));
     stats_.set("samples", samples);

@@ -290,6 +290,7 @@ void VctTechnique::prepare(const Scene& scene, const Settings& settings) {
         stats_.set("injection_ms", light_watch.elapsed_ms());
     }
     frame_index_ = 0;
+    stats_.set("update_ms", 0);  // no update since the build: a frame's total counts none
     stats_.set("prepare_ms", watch.elapsed_ms());
     stats_.set("triangles", double(scene_.frame().triangle_count()));
     stats_.set("voxelized_triangles", double(voxelizer_.triangle_count()));
