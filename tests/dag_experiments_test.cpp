@@ -141,10 +141,12 @@ TEST_F(DagExperimentsTest, Table3TimesArePositiveAndSplitMatchesWhole) {
             const double t_b = num(row, std::string("t_B_ms") + threads);
             const double codes = num(row, std::string("codes_to_svdag_ms") + threads);
             EXPECT_GT(t_b, 0) << row.dump();
-            // t_B is the identical-node search only, in whole and split rows alike; the
-            // phase that builds the levels from Morton codes is timed in both.
-            EXPECT_LT(t_b, codes) << row.dump();
+            EXPECT_GT(codes, 0) << row.dump();
+            // t_B is a part of the timed phase it was measured in (codes_to_svdag in a split
+            // row, t_A in a whole row), so it is smaller on any machine; codes_to_svdag of a
+            // whole row is another run, which a busy machine may make faster or slower.
             if (split) {
+                EXPECT_LT(t_b, codes) << row.dump();
                 // A split build converts no SVO: it has no t_A and no speedup against the paper's.
                 ASSERT_TRUE(row.contains(t_a_column)) << row.dump();
                 EXPECT_TRUE(row[t_a_column].is_null()) << row.dump();
