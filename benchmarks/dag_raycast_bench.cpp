@@ -6,10 +6,10 @@
 #include <map>
 #include <memory>
 #include <string>
-#include "core/asset_paths.hpp"
-#include "core/camera.hpp"
-#include "core/film.hpp"
-#include "core/settings.hpp"
+#include "core/io/asset_paths.hpp"
+#include "core/scene/camera.hpp"
+#include "core/image/film.hpp"
+#include "core/util/settings.hpp"
 #include "scenes/scene_library.hpp"
 #include "techniques/technique.hpp"
 

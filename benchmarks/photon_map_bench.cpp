@@ -6,12 +6,12 @@
 #include <benchmark/benchmark.h>
 
 #include <map>
-#include "accel/hash_grid_photon_map.hpp"
-#include "accel/kd_tree_photon_map.hpp"
-#include "accel/nanoflann_photon_map.hpp"
-#include "core/interaction.hpp"
-#include "core/light_sampler.hpp"
-#include "core/ray_tracer.hpp"
+#include "accel/photon/hash_grid_photon_map.hpp"
+#include "accel/photon/kd_tree_photon_map.hpp"
+#include "accel/photon/nanoflann_photon_map.hpp"
+#include "core/render/interaction.hpp"
+#include "core/render/light_sampler.hpp"
+#include "core/render/ray_tracer.hpp"
 #include "scenes/builtin_scenes.hpp"
 #include "techniques/photon_mapping/photon_gather.hpp"
 #include "techniques/photon_mapping/photon_tracer.hpp"

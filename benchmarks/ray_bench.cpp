@@ -1,7 +1,7 @@
 // Embree backend micro-benchmarks on the Cornell box: single rays vs streams.
 #include <benchmark/benchmark.h>
-#include "core/camera.hpp"
-#include "core/ray_tracer.hpp"
+#include "core/scene/camera.hpp"
+#include "core/render/ray_tracer.hpp"
 #include "scenes/builtin_scenes.hpp"
 
 using namespace gilab;

@@ -7,7 +7,7 @@
 
 #include <map>
 #include <memory>
-#include "core/hmd.hpp"
+#include "core/scene/hmd.hpp"
 #include "scenes/builtin_scenes.hpp"
 #include "techniques/photon_mapping/photon_technique.hpp"
 

@@ -10,15 +10,15 @@
 #include <optional>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include "accel/esvo.hpp"
-#include "accel/svdag.hpp"
-#include "accel/svo.hpp"
-#include "accel/voxel_ray_traversal.hpp"
-#include "core/asset_paths.hpp"
-#include "core/mesh_loaders.hpp"
-#include "core/scene.hpp"
-#include "core/stats.hpp"
-#include "core/voxelizer.hpp"
+#include "accel/dag/esvo.hpp"
+#include "accel/dag/svdag.hpp"
+#include "accel/dag/svo.hpp"
+#include "accel/dag/voxel_ray_traversal.hpp"
+#include "core/io/asset_paths.hpp"
+#include "core/io/mesh_loaders.hpp"
+#include "core/scene/scene.hpp"
+#include "core/util/stats.hpp"
+#include "core/voxel/voxelizer.hpp"
 
 using namespace gilab;
 

@@ -2,7 +2,7 @@
 
 #include <cstring>
 #include <limits>
-#include "core/error.hpp"
+#include "core/util/error.hpp"
 
 namespace gilab::python {
 

@@ -8,9 +8,9 @@
 #include <nlohmann/json.hpp>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
-#include "core/film.hpp"
-#include "core/math.hpp"
-#include "core/stats.hpp"
+#include "core/image/film.hpp"
+#include "core/util/math.hpp"
+#include "core/util/stats.hpp"
 
 namespace gilab::python {
 

@@ -3,9 +3,9 @@
 #include <filesystem>
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
-#include "core/camera.hpp"
-#include "core/error.hpp"
-#include "core/hmd.hpp"
+#include "core/scene/camera.hpp"
+#include "core/util/error.hpp"
+#include "core/scene/hmd.hpp"
 #include "python/array_helpers.hpp"
 #include "python/bindings.hpp"
 

@@ -1,8 +1,8 @@
 // What is available (techniques, scenes) and process-wide settings (memory budget), as
 // `gilab list` shows them and --memory-limit sets them.
 #include <pybind11/stl.h>
-#include "core/memory_budget.hpp"
-#include "experiments/result_writers.hpp"
+#include "core/util/memory_budget.hpp"
+#include "experiments/runner/result_writers.hpp"
 #include "python/bindings.hpp"
 #include "scenes/builtin_scenes.hpp"
 #include "scenes/scene_library.hpp"

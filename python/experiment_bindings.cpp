@@ -6,10 +6,10 @@
 #include <optional>
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
-#include "core/error.hpp"
-#include "core/parallel.hpp"
-#include "experiments/experiment.hpp"
-#include "experiments/experiment_batch.hpp"
+#include "core/util/error.hpp"
+#include "core/util/parallel.hpp"
+#include "experiments/runner/experiment.hpp"
+#include "experiments/runner/experiment_batch.hpp"
 #include "python/array_helpers.hpp"
 #include "python/bindings.hpp"
 

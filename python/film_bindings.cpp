@@ -3,8 +3,8 @@
 #include <memory>
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
-#include "core/film.hpp"
-#include "core/image_io.hpp"
+#include "core/image/film.hpp"
+#include "core/image/image_io.hpp"
 #include "python/array_helpers.hpp"
 #include "python/bindings.hpp"
 

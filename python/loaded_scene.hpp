@@ -2,7 +2,7 @@
 // What gilab.Scene holds: the scene as `gilab render` opens it, plus how it was named, so
 // Python calls on it reuse the CLI's own code (open_scene, describe_scene).
 #include <string>
-#include "core/asset_paths.hpp"
+#include "core/io/asset_paths.hpp"
 #include "scenes/scene_library.hpp"
 
 namespace gilab::python {

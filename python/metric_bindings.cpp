@@ -1,5 +1,5 @@
-// Image metrics of core/image_metrics.hpp on NumPy images: relMSE, SSIM, FLIP.
-#include "core/image_metrics.hpp"
+// Image metrics of core/image/image_metrics.hpp on NumPy images: relMSE, SSIM, FLIP.
+#include "core/image/image_metrics.hpp"
 #include "python/array_helpers.hpp"
 #include "python/bindings.hpp"
 

@@ -1,5 +1,5 @@
 // The `gilab` Python module: bindings over the C++ libraries, one file per concept.
-#include "core/error.hpp"
+#include "core/util/error.hpp"
 #include "python/bindings.hpp"
 
 namespace gilab::python {

@@ -7,11 +7,11 @@
 #include <cmath>
 #include <optional>
 #include <pybind11/stl.h>
-#include "accel/multi_frame_dag.hpp"
-#include "accel/svdag.hpp"
-#include "accel/temporal_svdag.hpp"
-#include "core/error.hpp"
-#include "core/voxelizer.hpp"
+#include "accel/temporal/multi_frame_dag.hpp"
+#include "accel/dag/svdag.hpp"
+#include "accel/dag/temporal_svdag.hpp"
+#include "core/util/error.hpp"
+#include "core/voxel/voxelizer.hpp"
 #include "python/array_helpers.hpp"
 #include "python/bindings.hpp"
 #include "python/loaded_scene.hpp"

@@ -2,11 +2,11 @@
 // (Laine & Karras layout) and gilab.Svdag (merged DAG), each with its node counts per
 // level, bytes, decoding and point / ray queries.
 #include <pybind11/stl.h>
-#include "accel/esvo.hpp"
-#include "accel/svdag.hpp"
-#include "accel/svo.hpp"
-#include "accel/voxel_ray_traversal.hpp"
-#include "core/error.hpp"
+#include "accel/dag/esvo.hpp"
+#include "accel/dag/svdag.hpp"
+#include "accel/dag/svo.hpp"
+#include "accel/dag/voxel_ray_traversal.hpp"
+#include "core/util/error.hpp"
 #include "python/array_helpers.hpp"
 #include "python/bindings.hpp"
 

@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <memory>
 #include <pybind11/stl.h>
-#include "accel/photon_map.hpp"
-#include "core/error.hpp"
+#include "accel/photon/photon_map.hpp"
+#include "core/util/error.hpp"
 #include "python/array_helpers.hpp"
 #include "python/bindings.hpp"
 

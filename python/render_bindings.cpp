@@ -1,5 +1,5 @@
 // gilab.render: one scene, one technique, a mono camera or an HMD stereo pair — through
-// the same steps as `gilab render` (experiments/render_command.hpp), so the images are
+// the same steps as `gilab render` (experiments/app/render_command.hpp), so the images are
 // bit-identical to the CLI's for the same scene, camera, settings and seed.
 #include <memory>
 #include <optional>
@@ -7,10 +7,10 @@
 #include <filesystem>
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
-#include "core/error.hpp"
-#include "core/parallel.hpp"
-#include "core/stats.hpp"
-#include "experiments/render_command.hpp"
+#include "core/util/error.hpp"
+#include "core/util/parallel.hpp"
+#include "core/util/stats.hpp"
+#include "experiments/app/render_command.hpp"
 #include "python/array_helpers.hpp"
 #include "python/bindings.hpp"
 #include "python/loaded_scene.hpp"

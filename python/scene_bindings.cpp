@@ -3,9 +3,9 @@
 #include <filesystem>
 #include <memory>
 #include <pybind11/stl.h>
-#include "core/error.hpp"
-#include "core/mesh_topology.hpp"
-#include "experiments/render_command.hpp"
+#include "core/util/error.hpp"
+#include "core/scene/mesh_topology.hpp"
+#include "experiments/app/render_command.hpp"
 #include "python/array_helpers.hpp"
 #include "python/bindings.hpp"
 #include "python/loaded_scene.hpp"

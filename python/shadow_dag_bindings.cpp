@@ -5,10 +5,10 @@
 #include <cmath>
 #include <optional>
 #include <pybind11/stl.h>
-#include "accel/shadow_dag.hpp"
-#include "core/error.hpp"
-#include "core/ray_tracer.hpp"
-#include "core/scene.hpp"
+#include "accel/shadow/shadow_dag.hpp"
+#include "core/util/error.hpp"
+#include "core/render/ray_tracer.hpp"
+#include "core/scene/scene.hpp"
 #include "python/array_helpers.hpp"
 #include "python/bindings.hpp"
 #include "python/loaded_scene.hpp"

@@ -3,11 +3,11 @@
 #include <memory>
 #include <optional>
 #include <pybind11/stl.h>
-#include "core/error.hpp"
-#include "core/morton.hpp"
-#include "core/scene.hpp"
-#include "core/voxel_grid.hpp"
-#include "core/voxelizer.hpp"
+#include "core/util/error.hpp"
+#include "core/util/morton.hpp"
+#include "core/scene/scene.hpp"
+#include "core/voxel/voxel_grid.hpp"
+#include "core/voxel/voxelizer.hpp"
 #include "python/array_helpers.hpp"
 #include "python/bindings.hpp"
 #include "python/loaded_scene.hpp"

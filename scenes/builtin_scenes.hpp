@@ -3,7 +3,7 @@
 #include <functional>
 #include <string>
 #include <vector>
-#include "core/scene.hpp"
+#include "core/scene/scene.hpp"
 
 namespace gilab {
 

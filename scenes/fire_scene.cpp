@@ -3,9 +3,9 @@
 #include <cmath>
 #include <string>
 #include <vector>
-#include "core/error.hpp"
-#include "core/format.hpp"
-#include "core/rng.hpp"
+#include "core/util/error.hpp"
+#include "core/util/format.hpp"
+#include "core/util/rng.hpp"
 #include "scenes/procedural_meshes.hpp"
 
 namespace gilab {

@@ -6,7 +6,7 @@
 // smears between keys), and all randomness comes from one stream seeded by `seed`, so
 // the same options always give the same scene.
 #include <cstdint>
-#include "core/scene.hpp"
+#include "core/scene/scene.hpp"
 
 namespace gilab {
 

@@ -1,7 +1,7 @@
 #include "scenes/procedural_meshes.hpp"
 
 #include <vector>
-#include "core/error.hpp"
+#include "core/util/error.hpp"
 
 namespace gilab {
 

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
-#include "core/mesh.hpp"
+#include "core/scene/mesh.hpp"
 
 namespace gilab {
 

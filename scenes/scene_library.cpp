@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <filesystem>
 #include <sstream>
-#include "core/build_info.hpp"
-#include "core/error.hpp"
-#include "core/mesh_loaders.hpp"
-#include "core/scene_file.hpp"
+#include "core/util/build_info.hpp"
+#include "core/util/error.hpp"
+#include "core/io/mesh_loaders.hpp"
+#include "core/io/scene_file.hpp"
 #include "scenes/builtin_scenes.hpp"
 
 namespace gilab {

@@ -5,8 +5,8 @@
 // framing the bounds (with a note in `warnings`).
 #include <string>
 #include <vector>
-#include "core/asset_paths.hpp"
-#include "core/scene.hpp"
+#include "core/io/asset_paths.hpp"
+#include "core/scene/scene.hpp"
 
 namespace gilab {
 

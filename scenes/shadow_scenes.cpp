@@ -3,7 +3,7 @@
 #include <cstdint>
 #include <string>
 #include <vector>
-#include "core/error.hpp"
+#include "core/util/error.hpp"
 #include "scenes/procedural_meshes.hpp"
 
 namespace gilab {

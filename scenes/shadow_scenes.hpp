@@ -2,7 +2,7 @@
 // Procedural stand-ins for the shadow-DAG paper's scenes: a closed architectural scene
 // (its "Villa" / "Citadel") and an open heightfield (its "Terrain"). Both are
 // deterministic and lit by a directional sun, the first light in the scene.
-#include "core/scene.hpp"
+#include "core/scene/scene.hpp"
 
 namespace gilab {
 

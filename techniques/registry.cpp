@@ -1,6 +1,6 @@
 #include "techniques/technique.hpp"
 
-#include "core/error.hpp"
+#include "core/util/error.hpp"
 #include "techniques/dag_raycast/dag_raycast_technique.hpp"
 #include "techniques/dag_shadows/dag_shadows_technique.hpp"
 #include "techniques/path_tracer/path_tracer.hpp"

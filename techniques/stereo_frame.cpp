@@ -1,7 +1,7 @@
 #include "techniques/stereo_frame.hpp"
 
 #include <vector>
-#include "core/stats.hpp"
+#include "core/util/stats.hpp"
 
 namespace gilab {
 

@@ -1,8 +1,8 @@
 #pragma once
 // One stereo frame from an HMD rig with any technique: both eyes go to a single render()
 // call, so a technique that reuses shading between the eyes can do so.
-#include "core/film.hpp"
-#include "core/hmd.hpp"
+#include "core/image/film.hpp"
+#include "core/scene/hmd.hpp"
 #include "techniques/technique.hpp"
 
 namespace gilab {

@@ -5,11 +5,11 @@
 #include <memory>
 #include <string>
 #include <vector>
-#include "core/camera.hpp"
-#include "core/film.hpp"
-#include "core/scene.hpp"
-#include "core/settings.hpp"
-#include "core/stats.hpp"
+#include "core/scene/camera.hpp"
+#include "core/image/film.hpp"
+#include "core/scene/scene.hpp"
+#include "core/util/settings.hpp"
+#include "core/util/stats.hpp"
 
 namespace gilab {
 

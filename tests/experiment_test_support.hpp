@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <initializer_list>
 #include <string>
-#include "experiments/experiment.hpp"
-#include "experiments/plot.hpp"
+#include "experiments/runner/experiment.hpp"
+#include "experiments/runner/plot.hpp"
 #include "tests/test_support.hpp"
 
 namespace gilab::test {

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <random>
 #include <vector>
-#include "accel/photon_map.hpp"
+#include "accel/photon/photon_map.hpp"
 
 namespace gilab::test {
 

@@ -1,7 +1,7 @@
 #include "tests/test_support.hpp"
 #include <fstream>
-#include "core/asset_paths.hpp"
-#include "core/error.hpp"
+#include "core/io/asset_paths.hpp"
+#include "core/util/error.hpp"
 
 namespace gilab::test {
 

@@ -5,10 +5,10 @@
 #include <cstdint>
 #include <random>
 #include <vector>
-#include "core/math.hpp"
-#include "core/morton.hpp"
-#include "core/ray.hpp"
-#include "core/voxel_grid.hpp"
+#include "core/util/math.hpp"
+#include "core/util/morton.hpp"
+#include "core/util/ray.hpp"
+#include "core/voxel/voxel_grid.hpp"
 
 namespace gilab::test {
 

@@ -2,11 +2,11 @@
 
 #include <string>
 #include <unordered_map>
-#include "accel/multi_frame_dag.hpp"
-#include "accel/sequence_voxelizer.hpp"
-#include "accel/svdag.hpp"
-#include "core/error.hpp"
-#include "core/voxelizer.hpp"
+#include "accel/temporal/multi_frame_dag.hpp"
+#include "accel/temporal/sequence_voxelizer.hpp"
+#include "accel/dag/svdag.hpp"
+#include "core/util/error.hpp"
+#include "core/voxel/voxelizer.hpp"
 
 namespace gilab {
 namespace {

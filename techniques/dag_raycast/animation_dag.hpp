@@ -7,10 +7,10 @@
 // about the shared DAG plus one batch of cells. The all-at-once build (mode (a))
 // voxelizes whole frames, keeps every frame's SVDAG and merges them together at the end.
 #include <vector>
-#include "accel/temporal_svdag.hpp"
-#include "core/light.hpp"
-#include "core/scene.hpp"
-#include "core/stats.hpp"
+#include "accel/dag/temporal_svdag.hpp"
+#include "core/scene/light.hpp"
+#include "core/scene/scene.hpp"
+#include "core/util/stats.hpp"
 #include "techniques/dag_raycast/dag_raycast_settings.hpp"
 
 namespace gilab {

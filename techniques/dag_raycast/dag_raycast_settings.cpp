@@ -2,8 +2,8 @@
 
 #include <cmath>
 #include <string>
-#include "core/error.hpp"
-#include "core/voxel_grid.hpp"
+#include "core/util/error.hpp"
+#include "core/voxel/voxel_grid.hpp"
 
 namespace gilab {
 namespace {

@@ -13,7 +13,7 @@
 // axis of each frame's shadow DAG), tile_size (16: image tile), seed (recorded only: nothing is random), spp (only 1: one
 // primary ray per pixel).
 #include <cstdint>
-#include "core/settings.hpp"
+#include "core/util/settings.hpp"
 
 namespace gilab {
 

@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include "accel/dag_ray_caster.hpp"
-#include "core/build_info.hpp"
-#include "core/error.hpp"
-#include "core/format.hpp"
-#include "core/parallel.hpp"
-#include "core/traced_scene.hpp"
+#include "accel/dag/dag_ray_caster.hpp"
+#include "core/util/build_info.hpp"
+#include "core/util/error.hpp"
+#include "core/util/format.hpp"
+#include "core/util/parallel.hpp"
+#include "core/render/traced_scene.hpp"
 #include "techniques/dag_raycast/voxel_face.hpp"
 
 namespace gilab {

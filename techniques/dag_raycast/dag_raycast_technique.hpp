@@ -16,8 +16,8 @@
 // Without a point, spot or directional light, a headlight at the eye stands in.
 #include <string>
 #include <vector>
-#include "accel/light_shadow_dags.hpp"
-#include "core/light.hpp"
+#include "accel/shadow/light_shadow_dags.hpp"
+#include "core/scene/light.hpp"
 #include "techniques/dag_raycast/animation_dag.hpp"
 #include "techniques/dag_raycast/dag_raycast_settings.hpp"
 #include "techniques/technique.hpp"

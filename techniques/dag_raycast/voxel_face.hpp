@@ -1,9 +1,9 @@
 #pragma once
 // The face of a voxel through which a ray enters it: the shading normal of a voxel hit
 // (voxels carry no surface normal of their own).
-#include "core/math.hpp"
-#include "core/ray.hpp"
-#include "core/voxel_grid.hpp"
+#include "core/util/math.hpp"
+#include "core/util/ray.hpp"
+#include "core/voxel/voxel_grid.hpp"
 
 namespace gilab {
 

@@ -1,10 +1,10 @@
 #include "techniques/dag_shadows/dag_shadows_technique.hpp"
 #include <cmath>
-#include "core/build_info.hpp"
-#include "core/error.hpp"
-#include "core/format.hpp"
-#include "core/interaction.hpp"
-#include "core/parallel.hpp"
+#include "core/util/build_info.hpp"
+#include "core/util/error.hpp"
+#include "core/util/format.hpp"
+#include "core/render/interaction.hpp"
+#include "core/util/parallel.hpp"
 
 namespace gilab {
 namespace {

@@ -18,9 +18,9 @@
 // turned away from the light, which are not looked up).
 #include <memory>
 #include <string>
-#include "accel/shadow_dag.hpp"
-#include "accel/shadow_map.hpp"
-#include "core/traced_scene.hpp"
+#include "accel/shadow/shadow_dag.hpp"
+#include "accel/shadow/shadow_map.hpp"
+#include "core/render/traced_scene.hpp"
 #include "techniques/technique.hpp"
 
 namespace gilab {

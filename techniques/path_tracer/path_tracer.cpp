@@ -2,14 +2,14 @@
 
 #include <atomic>
 #include <cmath>
-#include "core/bsdf.hpp"
-#include "core/build_info.hpp"
-#include "core/error.hpp"
-#include "core/format.hpp"
-#include "core/interaction.hpp"
-#include "core/parallel.hpp"
-#include "core/progress.hpp"
-#include "core/rng.hpp"
+#include "core/render/bsdf.hpp"
+#include "core/util/build_info.hpp"
+#include "core/util/error.hpp"
+#include "core/util/format.hpp"
+#include "core/render/interaction.hpp"
+#include "core/util/parallel.hpp"
+#include "core/util/progress.hpp"
+#include "core/util/rng.hpp"
 
 
 namespace gilab {

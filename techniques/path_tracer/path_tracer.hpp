@@ -15,7 +15,7 @@
 // not finite are dropped and counted in stats "nonfinite_samples".
 #include <cstdint>
 #include <string>
-#include "core/traced_scene.hpp"
+#include "core/render/traced_scene.hpp"
 #include "techniques/technique.hpp"
 
 namespace gilab {

@@ -16,7 +16,7 @@
 // The radius is kept: the hash grid's cells are r wide, so a larger radius would need a
 // 5×5×5 neighbourhood, and a smaller one removes photons from the disk but not from the
 // 27 cells the query visits — cost follows the photons visited, not those inside.
-#include "core/camera.hpp"
+#include "core/scene/camera.hpp"
 
 namespace gilab {
 

@@ -1,8 +1,8 @@
 #include "techniques/photon_mapping/photon_gather.hpp"
 
-#include "core/bsdf.hpp"
-#include "core/error.hpp"
-#include "core/morton.hpp"
+#include "core/render/bsdf.hpp"
+#include "core/util/error.hpp"
+#include "core/util/morton.hpp"
 
 namespace gilab {
 

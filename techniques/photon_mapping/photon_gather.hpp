@@ -22,10 +22,10 @@
 #include <cstdint>
 #include <span>
 #include <vector>
-#include "accel/hash_grid_photon_map.hpp"
-#include "accel/kd_tree_photon_map.hpp"
-#include "accel/nanoflann_photon_map.hpp"
-#include "core/material.hpp"
+#include "accel/photon/hash_grid_photon_map.hpp"
+#include "accel/photon/kd_tree_photon_map.hpp"
+#include "accel/photon/nanoflann_photon_map.hpp"
+#include "core/scene/material.hpp"
 
 namespace gilab {
 

@@ -4,7 +4,7 @@
 #include <atomic>
 #include <span>
 #include <vector>
-#include "core/rng.hpp"
+#include "core/util/rng.hpp"
 #include "techniques/photon_mapping/photon_technique.hpp"
 #include "techniques/photon_mapping/primary_hit.hpp"
 

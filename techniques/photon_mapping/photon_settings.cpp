@@ -1,7 +1,7 @@
 #include <cmath>
-#include "core/error.hpp"
-#include "core/format.hpp"
-#include "core/memory_budget.hpp"
+#include "core/util/error.hpp"
+#include "core/util/format.hpp"
+#include "core/util/memory_budget.hpp"
 #include "techniques/photon_mapping/photon_technique.hpp"
 
 namespace gilab {

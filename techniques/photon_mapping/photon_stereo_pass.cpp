@@ -7,9 +7,9 @@
 // right pixels, and each right pixel averages its samples as the left eye does.
 #include <mutex>
 #include <optional>
-#include "core/interaction.hpp"
-#include "core/parallel.hpp"
-#include "core/rng.hpp"
+#include "core/render/interaction.hpp"
+#include "core/util/parallel.hpp"
+#include "core/util/rng.hpp"
 #include "techniques/photon_mapping/photon_passes.hpp"
 
 namespace gilab {

@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include "core/build_info.hpp"
-#include "core/error.hpp"
-#include "core/format.hpp"
+#include "core/util/build_info.hpp"
+#include "core/util/error.hpp"
+#include "core/util/format.hpp"
 #include "techniques/photon_mapping/photon_passes.hpp"
 #include "techniques/photon_mapping/photon_tracer.hpp"
 

@@ -75,17 +75,17 @@
 #include <memory>
 #include <optional>
 #include <string>
-#include "accel/hash_grid_photon_map.hpp"
-#include "accel/photon_map.hpp"
-#include "core/light_sampler.hpp"
-#include "core/ray_tracer.hpp"
+#include "accel/photon/hash_grid_photon_map.hpp"
+#include "accel/photon/photon_map.hpp"
+#include "core/render/light_sampler.hpp"
+#include "core/render/ray_tracer.hpp"
 #include "techniques/photon_mapping/foveation.hpp"
 #include "techniques/photon_mapping/photon_gather.hpp"
 #include "techniques/photon_mapping/pixel_samples.hpp"
 #include "techniques/photon_mapping/progressive.hpp"
 #include "techniques/photon_mapping/stereo_reuse.hpp"
 #include "techniques/photon_mapping/tile_share.hpp"
-#include "core/traced_scene.hpp"
+#include "core/render/traced_scene.hpp"
 #include "techniques/technique.hpp"
 
 namespace gilab {

@@ -1,11 +1,11 @@
 #include "techniques/photon_mapping/photon_tracer.hpp"
 
 #include <atomic>
-#include "core/bsdf.hpp"
-#include "core/error.hpp"
-#include "core/interaction.hpp"
-#include "core/parallel.hpp"
-#include "core/stats.hpp"
+#include "core/render/bsdf.hpp"
+#include "core/util/error.hpp"
+#include "core/render/interaction.hpp"
+#include "core/util/parallel.hpp"
+#include "core/util/stats.hpp"
 
 namespace gilab {
 

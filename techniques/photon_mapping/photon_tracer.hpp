@@ -16,10 +16,10 @@
 // photon order.
 #include <cstdint>
 #include <vector>
-#include "accel/photon.hpp"
-#include "core/light_sampler.hpp"
-#include "core/material.hpp"
-#include "core/ray_tracer.hpp"
+#include "accel/photon/photon.hpp"
+#include "core/render/light_sampler.hpp"
+#include "core/scene/material.hpp"
+#include "core/render/ray_tracer.hpp"
 
 namespace gilab {
 

@@ -8,10 +8,10 @@
 #include <mutex>
 #include <optional>
 #include <tbb/parallel_sort.h>
-#include "core/error.hpp"
-#include "core/interaction.hpp"
-#include "core/parallel.hpp"
-#include "core/rng.hpp"
+#include "core/util/error.hpp"
+#include "core/render/interaction.hpp"
+#include "core/util/parallel.hpp"
+#include "core/util/rng.hpp"
 #include "techniques/photon_mapping/photon_passes.hpp"
 
 namespace gilab {

@@ -1,6 +1,6 @@
 #include "techniques/photon_mapping/pixel_samples.hpp"
 
-#include "core/memory_budget.hpp"
+#include "core/util/memory_budget.hpp"
 
 namespace gilab {
 

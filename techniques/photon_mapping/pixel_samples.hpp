@@ -14,8 +14,8 @@
 #include <span>
 #include <string>
 #include <vector>
-#include "core/camera.hpp"
-#include "core/rng.hpp"
+#include "core/scene/camera.hpp"
+#include "core/util/rng.hpp"
 
 namespace gilab {
 

@@ -1,6 +1,6 @@
 #include "techniques/photon_mapping/primary_hit.hpp"
 
-#include "core/bsdf.hpp"
+#include "core/render/bsdf.hpp"
 
 namespace gilab {
 

@@ -8,10 +8,10 @@
 #include <cstdint>
 #include <span>
 #include <vector>
-#include "core/camera.hpp"
-#include "core/interaction.hpp"
-#include "core/light_sampler.hpp"
-#include "core/ray_tracer.hpp"
+#include "core/scene/camera.hpp"
+#include "core/render/interaction.hpp"
+#include "core/render/light_sampler.hpp"
+#include "core/render/ray_tracer.hpp"
 #include "techniques/photon_mapping/photon_gather.hpp"
 
 namespace gilab {

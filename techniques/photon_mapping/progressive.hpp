@@ -16,7 +16,7 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
-#include "core/math.hpp"
+#include "core/util/math.hpp"
 
 namespace gilab {
 

@@ -10,14 +10,14 @@
 // iteration are stored, which the paper's grid over visible points avoids.
 #include <algorithm>
 #include <atomic>
-#include "core/bsdf.hpp"
-#include "core/build_info.hpp"
-#include "core/error.hpp"
-#include "core/format.hpp"
-#include "core/interaction.hpp"
-#include "core/parallel.hpp"
-#include "core/progress.hpp"
-#include "core/stats.hpp"
+#include "core/render/bsdf.hpp"
+#include "core/util/build_info.hpp"
+#include "core/util/error.hpp"
+#include "core/util/format.hpp"
+#include "core/render/interaction.hpp"
+#include "core/util/parallel.hpp"
+#include "core/util/progress.hpp"
+#include "core/util/stats.hpp"
 #include "techniques/photon_mapping/photon_passes.hpp"
 #include "techniques/photon_mapping/photon_tracer.hpp"
 

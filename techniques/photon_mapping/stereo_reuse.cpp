@@ -2,8 +2,8 @@
 
 #include <bit>
 #include <cmath>
-#include "core/interaction.hpp"
-#include "core/parallel.hpp"
+#include "core/render/interaction.hpp"
+#include "core/util/parallel.hpp"
 
 namespace gilab {
 

@@ -28,8 +28,8 @@
 #include <optional>
 #include <span>
 #include <vector>
-#include "core/camera.hpp"
-#include "core/ray_tracer.hpp"
+#include "core/scene/camera.hpp"
+#include "core/render/ray_tracer.hpp"
 #include "techniques/photon_mapping/primary_hit.hpp"
 
 namespace gilab {

@@ -1,7 +1,7 @@
 #include "techniques/photon_mapping/tile_share.hpp"
 
 #include <optional>
-#include "core/error.hpp"
+#include "core/util/error.hpp"
 
 namespace gilab {
 

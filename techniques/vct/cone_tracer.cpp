@@ -1,7 +1,7 @@
 #include "techniques/vct/cone_tracer.hpp"
 
 #include <cmath>
-#include "core/error.hpp"
+#include "core/util/error.hpp"
 
 namespace gilab {
 

@@ -23,10 +23,10 @@
 // trilinear footprint of a coarse level; the optional clip plane (the surface's tangent
 // plane) removes voxels behind it and the back-facing faces of voxels it cuts.
 #include <vector>
-#include "accel/anisotropic_voxel.hpp"
-#include "accel/cascaded_voxel_texture.hpp"
-#include "accel/dense_mip_texture.hpp"
-#include "core/math.hpp"
+#include "accel/vct/anisotropic_voxel.hpp"
+#include "accel/vct/cascaded_voxel_texture.hpp"
+#include "accel/vct/dense_mip_texture.hpp"
+#include "core/util/math.hpp"
 
 namespace gilab {
 

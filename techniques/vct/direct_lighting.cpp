@@ -1,8 +1,8 @@
 #include "techniques/vct/direct_lighting.hpp"
 
 #include <cmath>
-#include "core/bsdf.hpp"
-#include "core/interaction.hpp"
+#include "core/render/bsdf.hpp"
+#include "core/render/interaction.hpp"
 
 namespace gilab {
 

@@ -6,12 +6,12 @@
 // triangle) from an Rng keyed by what is being lit (a world voxel face or a pixel).
 #include <cstdint>
 #include <vector>
-#include "core/light.hpp"
-#include "core/light_sampler.hpp"
-#include "core/material.hpp"
-#include "core/ray_tracer.hpp"
-#include "core/rng.hpp"
-#include "core/sampling.hpp"
+#include "core/scene/light.hpp"
+#include "core/render/light_sampler.hpp"
+#include "core/scene/material.hpp"
+#include "core/render/ray_tracer.hpp"
+#include "core/util/rng.hpp"
+#include "core/render/sampling.hpp"
 
 namespace gilab {
 

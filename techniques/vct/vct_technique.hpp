@@ -42,11 +42,11 @@
 #include <optional>
 #include <string>
 #include <vector>
-#include "accel/anisotropic_voxelizer.hpp"
-#include "accel/cascaded_voxel_texture.hpp"
-#include "accel/dense_mip_texture.hpp"
-#include "core/ray_tracer.hpp"
-#include "core/traced_scene.hpp"
+#include "accel/vct/anisotropic_voxelizer.hpp"
+#include "accel/vct/cascaded_voxel_texture.hpp"
+#include "accel/vct/dense_mip_texture.hpp"
+#include "core/render/ray_tracer.hpp"
+#include "core/render/traced_scene.hpp"
 #include "techniques/technique.hpp"
 #include "techniques/vct/cone_tracer.hpp"
 #include "techniques/vct/direct_lighting.hpp"

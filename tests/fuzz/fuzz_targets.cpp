@@ -7,11 +7,11 @@
 #include <stdexcept>
 #include <string_view>
 #include <typeinfo>
-#include "core/error.hpp"
-#include "core/memory_budget.hpp"
-#include "core/mesh_loaders.hpp"
-#include "core/scene_file.hpp"
-#include "core/settings.hpp"
+#include "core/util/error.hpp"
+#include "core/util/memory_budget.hpp"
+#include "core/io/mesh_loaders.hpp"
+#include "core/io/scene_file.hpp"
+#include "core/util/settings.hpp"
 
 namespace gilab::fuzz {
 

@@ -1,6 +1,6 @@
 #pragma once
 // The loaders and parsers under fuzzing, each as one function of raw bytes. The libFuzzer
-// harnesses (tests/fuzz/*_fuzz.cpp) and the regression test (tests/core_fuzz_corpus_test)
+// harnesses (tests/fuzz/*_fuzz.cpp) and the regression test (tests/core/io/fuzz_corpus_test)
 // call the same functions, so an input the fuzzer found is replayed exactly as found.
 //
 // A target returns normally when the input loads or is refused with gilab::Error, which

@@ -12,7 +12,7 @@
 # A crash, leak, timeout (5 s) or out-of-memory input (2 GB) is written to
 # build-fuzz/findings/TARGET/ and fuzzing goes on for the whole time (libFuzzer's fork
 # mode); once fixed, the input belongs in tests/fuzz/corpus/TARGET/, which
-# core_fuzz_corpus_test replays in the normal suite. The script ends with the
+# fuzz_corpus_test replays in the normal suite. The script ends with the
 # executions and findings of each target and exits non-zero when there is a finding.
 set -euo pipefail
 cd "$(dirname "$0")/../.."

@@ -1,0 +1,348 @@
+#include "accel/vct/cascaded_voxel_texture.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <string>
+#include "core/util/error.hpp"
+#include "core/util/parallel.hpp"
+
+namespace gilab {
+
+void CascadeConfig::validate() const {
+    const std::string where = "cascaded voxel texture";
+    if (levels < 1 || levels > 16) throw Error(where, "levels must be 1..16, got " + std::to_string(levels));
+    if (resolution < 4 || resolution > 1024 || !std::has_single_bit(unsigned(resolution)))
+        throw Error(where, "resolution must be a power of two in 4..1024, got " + std::to_string(resolution));
+    if (!(voxel_size > 0) || !std::isfinite(voxel_size))
+        throw Error(where, "voxel size must be positive and finite, got " + std::to_string(voxel_size));
+    if (!std::isfinite(anchor.x) || !std::isfinite(anchor.y) || !std::isfinite(anchor.z))
+        throw Error(where, "anchor must be finite");
+    double cells = double(levels) * double(resolution) * double(resolution) * double(resolution) * kFaceCount;
+    if (cells * 80.0 > double(size_t(8) << 30))
+        throw Error(where, std::to_string(levels) + " levels of " + std::to_string(resolution) +
+                               "³ would need more than 8 GiB");
+}
+
+CascadedVoxelTexture::CascadedVoxelTexture(const CascadeConfig& config) : config_(config) {
+    config_.validate();
+    origins_.assign(size_t(config_.levels), IVec3(-config_.resolution / 2));
+    own_inner_.assign(size_t(config_.levels), VoxelBox{});
+    gbuffer_clear_.assign(size_t(config_.levels), 1);
+    const size_t n = cell_count();
+    opacity.assign(n, 0.0f);
+    albedo.assign(n, Vec3(0));
+    normal.assign(n, Vec3(0));
+    emission.assign(n, Vec3(0));
+    position.assign(n, Vec3(0));
+    direct.assign(n, Vec4(0));
+    radiance.assign(n, Vec4(0));
+}
+
+VoxelBox CascadedVoxelTexture::region(int level) const {
+    IVec3 o = origins_.at(size_t(level));
+    return {o, o + IVec3(config_.resolution)};
+}
+
+IVec3 CascadedVoxelTexture::origin_for(const DVec3& viewer, int level) const {
+    DVec3 q = to_level_space(viewer, level);
+    IVec3 centre;
+    for (int k = 0; k < 3; ++k) centre[k] = 2 * int(std::floor(q[k] * 0.5 + 0.5));
+    return centre - IVec3(config_.resolution / 2);
+}
+
+IVec3 CascadedVoxelTexture::world_to_voxel(const DVec3& p, int level) const {
+    DVec3 q = glm::floor(to_level_space(p, level));
+    return IVec3(int(q.x), int(q.y), int(q.z));
+}
+
+DVec3 CascadedVoxelTexture::voxel_center(const IVec3& v, int level) const {
+    return config_.anchor + (DVec3(v) + DVec3(0.5)) * voxel_size(level);
+}
+
+int CascadedVoxelTexture::finest_level_containing(const DVec3& p, double margin) const {
+    for (int k = 0; k < config_.levels; ++k) {
+        DVec3 q = to_level_space(p, k) - DVec3(origins_[size_t(k)]);
+        const double hi = double(config_.resolution) - margin;
+        if (q.x >= margin && q.y >= margin && q.z >= margin && q.x < hi && q.y < hi && q.z < hi) return k;
+    }
+    return -1;
+}
+
+IVec3 CascadedVoxelTexture::voxel_at_texel(int level, const UVec3& texel) const {
+    const IVec3 o = origins_.at(size_t(level));
+    const int R = config_.resolution, mask = R - 1;
+    IVec3 v;
+    for (int k = 0; k < 3; ++k) v[k] = o[k] + ((int(texel[k]) - o[k]) & mask);
+    return v;
+}
+
+VoxelBox CascadedVoxelTexture::inner_box(int level) const {
+    if (level <= 0) return {};
+    VoxelBox finer = region(level - 1);
+    VoxelBox box{IVec3(floor_div(finer.begin.x, 2), floor_div(finer.begin.y, 2), floor_div(finer.begin.z, 2)),
+                 IVec3(floor_div(finer.end.x + 1, 2), floor_div(finer.end.y + 1, 2), floor_div(finer.end.z + 1, 2))};
+    return box.intersect(region(level));
+}
+
+void CascadedVoxelTexture::place(int level, const IVec3& origin) {
+    if (level < 0 || level >= config_.levels) throw Error("cascaded voxel texture", "no level " + std::to_string(level));
+    origins_[size_t(level)] = origin;
+    own_inner_[size_t(level)] = VoxelBox{};
+    // Whole level: one z slice per task.
+    const int R = config_.resolution;
+    gilab::parallel_for(size_t(R), 1, [&](size_t z0, size_t z1) {
+        for (size_t z = z0; z < z1; ++z) {
+            const size_t first = index(0, level, UVec3(0, 0, uint32_t(z))), n = size_t(R) * width();
+            std::fill_n(opacity.begin() + ptrdiff_t(first), n, 0.0f);
+            for (auto* a : {&albedo, &normal, &emission, &position}) std::fill_n(a->begin() + ptrdiff_t(first), n, Vec3(0));
+            for (auto* a : {&direct, &radiance}) std::fill_n(a->begin() + ptrdiff_t(first), n, Vec4(0));
+        }
+    });
+    gbuffer_clear_[size_t(level)] = true;
+}
+
+namespace {
+
+// Calls fn(v) for every voxel of the box, z outermost.
+template <class Fn>
+void for_each_voxel(const VoxelBox& box, Fn&& fn) {
+    for (int z = box.begin.z; z < box.end.z; ++z)
+        for (int y = box.begin.y; y < box.end.y; ++y)
+            for (int x = box.begin.x; x < box.end.x; ++x) fn(IVec3(x, y, z));
+}
+
+}  // namespace
+
+// Calls fn(first_cell, count) for every contiguous run of cells (one face, one texel
+// row) that the box's voxels occupy; a row wraps around the toroidal storage at most once.
+template <class Fn>
+void CascadedVoxelTexture::for_each_run(int level, const VoxelBox& box, Fn&& fn) const {
+    const VoxelBox b = box.intersect(region(level));
+    if (b.empty()) return;
+    const int R = config_.resolution, mask = R - 1;
+    const int x0 = b.begin.x & mask, nx = b.end.x - b.begin.x;
+    const int first = std::min(nx, R - x0), second = nx - first;
+    for (int z = b.begin.z; z < b.end.z; ++z)
+        for (int y = b.begin.y; y < b.end.y; ++y)
+            for (int f = 0; f < kFaceCount; ++f) {
+                const UVec3 t(uint32_t(x0), uint32_t(y & mask), uint32_t(z & mask));
+                fn(index(f, level, t), size_t(first));
+                if (second > 0) fn(index(f, level, UVec3(0, t.y, t.z)), size_t(second));
+            }
+}
+
+void CascadedVoxelTexture::clear_gbuffer(int level, const VoxelBox& box) {
+    if (gbuffer_clear_[size_t(level)]) return;  // nothing written since the level was cleared
+    for_each_run(level, box, [&](size_t i, size_t n) {
+        std::fill_n(opacity.begin() + ptrdiff_t(i), n, 0.0f);
+        std::fill_n(albedo.begin() + ptrdiff_t(i), n, Vec3(0));
+        std::fill_n(normal.begin() + ptrdiff_t(i), n, Vec3(0));
+        std::fill_n(emission.begin() + ptrdiff_t(i), n, Vec3(0));
+        std::fill_n(position.begin() + ptrdiff_t(i), n, Vec3(0));
+    });
+}
+
+void CascadedVoxelTexture::clear_radiance(int level, const VoxelBox& box) {
+    for_each_run(level, box, [&](size_t i, size_t n) {
+        std::fill_n(direct.begin() + ptrdiff_t(i), n, Vec4(0));
+        std::fill_n(radiance.begin() + ptrdiff_t(i), n, Vec4(0));
+    });
+}
+
+std::vector<VoxelBox> CascadedVoxelTexture::scroll(int level, const IVec3& new_origin) {
+    if (level < 0 || level >= config_.levels) throw Error("cascaded voxel texture", "no level " + std::to_string(level));
+    const VoxelBox old_box = region(level);
+    origins_[size_t(level)] = new_origin;
+    const VoxelBox new_box = region(level);
+    std::vector<VoxelBox> exposed;
+    if (old_box.intersect(new_box).empty()) {
+        exposed.push_back(new_box);
+    } else {
+        // Peel one axis at a time: the slab outside the old box along x, then along y
+        // within the old x range, then along z within the old x and y ranges.
+        VoxelBox rest = new_box;
+        for (int k = 0; k < 3; ++k) {
+            if (rest.begin[k] < old_box.begin[k]) {
+                VoxelBox slab = rest;
+                slab.end[k] = old_box.begin[k];
+                exposed.push_back(slab);
+                rest.begin[k] = old_box.begin[k];
+            }
+            if (rest.end[k] > old_box.end[k]) {
+                VoxelBox slab = rest;
+                slab.begin[k] = old_box.end[k];
+                exposed.push_back(slab);
+                rest.end[k] = old_box.end[k];
+            }
+        }
+    }
+    const bool has_coarser = level + 1 < config_.levels;
+    for (const VoxelBox& box : exposed) {
+        clear_gbuffer(level, box);
+        for_each_voxel(box, [&](const IVec3& v) {
+            const IVec3 parent(floor_div(v.x, 2), floor_div(v.y, 2), floor_div(v.z, 2));
+            const bool fill = has_coarser && contains(level + 1, parent);
+            for (int f = 0; f < kFaceCount; ++f) {
+                size_t i = index_of_voxel(f, level, v);
+                if (fill) {
+                    size_t j = index_of_voxel(f, level + 1, parent);
+                    direct[i] = direct[j];
+                    radiance[i] = radiance[j];
+                } else {
+                    direct[i] = radiance[i] = Vec4(0);
+                }
+            }
+        });
+    }
+    return exposed;
+}
+
+void CascadedVoxelTexture::write(int level, const AnisotropicVoxel& voxel) {
+    gbuffer_clear_[size_t(level)] = false;
+    if (!contains(level, voxel.coord))
+        throw Error("cascaded voxel texture", "voxel outside level " + std::to_string(level) + "'s region");
+    for (int f = 0; f < kFaceCount; ++f) {
+        const VoxelFaceData& d = voxel.faces[size_t(f)];
+        size_t i = index_of_voxel(f, level, voxel.coord);
+        opacity[i] = d.opacity;
+        albedo[i] = d.albedo;
+        normal[i] = d.normal;
+        emission[i] = d.emission;
+        position[i] = d.position;
+    }
+}
+
+AnisotropicVoxel CascadedVoxelTexture::read(int level, const IVec3& v) const {
+    AnisotropicVoxel voxel;
+    voxel.coord = v;
+    if (!contains(level, v)) return voxel;
+    for (int f = 0; f < kFaceCount; ++f) {
+        size_t i = index_of_voxel(f, level, v);
+        VoxelFaceData& d = voxel.faces[size_t(f)];
+        d.opacity = opacity[i];
+        d.albedo = albedo[i];
+        d.normal = normal[i];
+        d.emission = emission[i];
+        d.position = position[i];
+    }
+    return voxel;
+}
+
+FragmentVoxelizeStats CascadedVoxelTexture::voxelize(int level, const AnisotropicVoxelizer& voxelizer,
+                                                     const VoxelBox& box) {
+    const VoxelBox b = box.intersect(region(level));
+    clear_gbuffer(level, b);
+    FragmentVoxelizeStats stats;
+    if (b.empty()) return stats;
+    // Voxels of one brick are written by one task and bricks never share a voxel.
+    voxelizer.voxelize_each(lattice(level), b, [&](const AnisotropicVoxel& v) { write(level, v); }, &stats);
+    return stats;
+}
+
+std::vector<VoxelBox> subtract(const VoxelBox& a, const VoxelBox& b) {
+    std::vector<VoxelBox> out;
+    if (a.empty()) return out;
+    if (a.intersect(b).empty()) {
+        out.push_back(a);
+        return out;
+    }
+    VoxelBox rest = a;
+    for (int k = 0; k < 3; ++k) {
+        if (rest.begin[k] < b.begin[k]) {
+            VoxelBox slab = rest;
+            slab.end[k] = b.begin[k];
+            out.push_back(slab);
+            rest.begin[k] = b.begin[k];
+        }
+        if (rest.end[k] > b.end[k]) {
+            VoxelBox slab = rest;
+            slab.begin[k] = b.end[k];
+            out.push_back(slab);
+            rest.end[k] = b.end[k];
+        }
+    }
+    return out;
+}
+
+FragmentVoxelizeStats CascadedVoxelTexture::voxelize_own(int level, const AnisotropicVoxelizer& voxelizer,
+                                                         const VoxelBox& box) {
+    const VoxelBox inner = inner_box(level);
+    own_inner_[size_t(level)] = inner;
+    const VoxelBox b = box.intersect(region(level));
+    clear_gbuffer(level, b);
+    FragmentVoxelizeStats stats;
+    if (b.empty()) return stats;
+    voxelizer.voxelize_each(lattice(level), b, [&](const AnisotropicVoxel& v) { write(level, v); }, &stats, inner);
+    return stats;
+}
+
+FragmentVoxelizeStats CascadedVoxelTexture::follow_inner(int level, const AnisotropicVoxelizer& voxelizer,
+                                                         const std::vector<VoxelBox>& exposed) {
+    FragmentVoxelizeStats stats;
+    const VoxelBox old_inner = own_inner_[size_t(level)].intersect(region(level));
+    const VoxelBox inner = inner_box(level);
+    own_inner_[size_t(level)] = inner;
+    std::vector<VoxelBox> pending;
+    for (const VoxelBox& b : exposed) pending.push_back(b.intersect(region(level)));
+    if (!(old_inner.begin == inner.begin && old_inner.end == inner.end)) {
+        for (const VoxelBox& part : subtract(inner, old_inner)) clear_gbuffer(level, part);
+        for (const VoxelBox& part : subtract(old_inner, inner)) {
+            clear_gbuffer(level, part);
+            pending.push_back(part);
+        }
+    }
+    if (pending.empty()) return stats;
+    voxelizer.voxelize_each(lattice(level), pending, [&](const AnisotropicVoxel& v) { write(level, v); }, &stats, inner);
+    return stats;
+}
+
+bool CascadedVoxelTexture::occupied(int level, const IVec3& v) const {
+    if (!contains(level, v)) return false;
+    for (int f = 0; f < kFaceCount; ++f)
+        if (opacity[index_of_voxel(f, level, v)] > 0.0f) return true;
+    return false;
+}
+
+size_t CascadedVoxelTexture::occupied_voxels(int level) const { return occupied_in(level, region(level)).size(); }
+
+std::vector<IVec3> CascadedVoxelTexture::occupied_in(int level, const VoxelBox& box) const {
+    std::vector<IVec3> out;
+    for_each_voxel(box.intersect(region(level)), [&](const IVec3& v) {
+        if (occupied(level, v)) out.push_back(v);
+    });
+    return out;
+}
+
+void CascadedVoxelTexture::downsample(int level, std::vector<Vec4>& buffer) const {
+    const VoxelBox box = inner_box(level);
+    if (box.empty()) return;
+    const int zs = box.end.z - box.begin.z;
+    parallel_for(size_t(zs), 1, [&](size_t z0, size_t z1) {
+        for (size_t dz = z0; dz < z1; ++dz) {
+            const int z = box.begin.z + int(dz);
+            for (int y = box.begin.y; y < box.end.y; ++y)
+                for (int x = box.begin.x; x < box.end.x; ++x) {
+                    const IVec3 v(x, y, z);
+                    for (int f = 0; f < kFaceCount; ++f) {
+                        std::array<Vec4, 8> children;
+                        for (int c = 0; c < 8; ++c) {
+                            const IVec3 child = 2 * v + IVec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+                            children[size_t(c)] =
+                                contains(level - 1, child) ? buffer[index_of_voxel(f, level - 1, child)] : Vec4(0);
+                        }
+                        buffer[index_of_voxel(f, level, v)] = downsample_face(f, children);
+                    }
+                }
+        }
+    });
+}
+
+size_t CascadedVoxelTexture::gbuffer_bytes() const {
+    return opacity.size() * sizeof(float) +
+           (albedo.size() + normal.size() + emission.size() + position.size()) * sizeof(Vec3);
+}
+
+size_t CascadedVoxelTexture::radiance_bytes() const { return (direct.size() + radiance.size()) * sizeof(Vec4); }
+
+}  // namespace gilab

@@ -1,0 +1,148 @@
+#pragma once
+// Cascaded voxel texture (P3 §1.1): n nested, viewer-centred cascades of R³ voxels,
+// level k having voxels of size voxel_size·2^k. Every voxel keeps six faces (see
+// accel/vct/anisotropic_voxel.hpp). Each attribute is one allocation laid out as the paper's
+// Fig. 2: a 3D array of 6R × nR × R cells whose x axis is the six faces side by side,
+// y axis the n levels stacked, z the third voxel axis — so cell
+// (face·R + tx, level·R + ty, tz) holds texel (tx, ty, tz) of that face and level.
+//
+// Voxels are addressed by world voxel coordinates on the level's lattice (voxel v of
+// level k spans anchor + [v, v+1)·voxel_size·2^k). A level covers the box
+// [origin, origin + R) and stores voxel v at texel v mod R (toroidal), so moving the
+// level by a few voxels (scroll) keeps every voxel that stays inside where it is; only
+// the newly exposed slabs need new data. Level origins are snapped to even voxel
+// coordinates: the region of level k then covers whole voxels of level k + 1, whose
+// inner part can be filtered from it 2×2×2 → 1.
+#include <cstdint>
+#include <vector>
+#include "accel/vct/anisotropic_voxel.hpp"
+#include "accel/vct/anisotropic_voxelizer.hpp"
+#include "core/util/math.hpp"
+
+namespace gilab {
+
+struct CascadeConfig {
+    int levels = 6;
+    int resolution = 32;       // voxels per axis of every level: a power of two, 4..1024
+    double voxel_size = 1.0;   // level 0 (the finest)
+    DVec3 anchor{0};           // lattice origin shared by every level
+    // Throws Error naming the bad field.
+    void validate() const;
+};
+
+class CascadedVoxelTexture {
+public:
+    CascadedVoxelTexture() = default;
+    explicit CascadedVoxelTexture(const CascadeConfig& config);  // allocates every attribute
+
+    const CascadeConfig& config() const { return config_; }
+    int levels() const { return config_.levels; }
+    int resolution() const { return config_.resolution; }
+    double voxel_size(int level) const { return std::ldexp(config_.voxel_size, level); }
+    VoxelLattice lattice(int level) const { return {config_.anchor, voxel_size(level)}; }
+
+    // ---- placement
+    IVec3 origin(int level) const { return origins_[size_t(level)]; }
+    VoxelBox region(int level) const;
+    // The origin that centres `level` on `viewer`: the centre is the even lattice
+    // coordinate nearest to the viewer, the region [centre − R/2, centre + R/2).
+    IVec3 origin_for(const DVec3& viewer, int level) const;
+    // Moves a level without keeping anything: its whole G-buffer and radiance are cleared.
+    void place(int level, const IVec3& origin);
+    // Moves a level keeping what stays inside; returns the newly exposed boxes (disjoint;
+    // the whole region when nothing overlaps). Their G-buffer is cleared and their
+    // radiance filled from the next coarser level's voxel holding them (mipmap
+    // approximation until the level is lit again), zero if that level does not hold it.
+    std::vector<VoxelBox> scroll(int level, const IVec3& new_origin);
+    // Part of `level` covered by level − 1, in level units (empty for level 0).
+    VoxelBox inner_box(int level) const;
+
+    // ---- addressing
+    IVec3 world_to_voxel(const DVec3& p, int level) const;
+    DVec3 voxel_center(const IVec3& v, int level) const;
+    // Continuous coordinates in level voxel units (voxel v spans [v, v+1)).
+    DVec3 to_level_space(const DVec3& p, int level) const { return (p - config_.anchor) / voxel_size(level); }
+    bool contains(int level, const IVec3& v) const { return region(level).contains(v); }
+    // The finest level whose region holds p at least `margin` voxels (of that level)
+    // away from its border; -1 if none does.
+    int finest_level_containing(const DVec3& p, double margin = 0) const;
+    UVec3 texel_of(const IVec3& v) const {
+        const int mask = config_.resolution - 1;
+        return UVec3(uint32_t(v.x & mask), uint32_t(v.y & mask), uint32_t(v.z & mask));
+    }
+    // The voxel of the current region stored at a texel (inverse of texel_of).
+    IVec3 voxel_at_texel(int level, const UVec3& texel) const;
+    // Cell index of (face, level, texel) in every attribute array (Fig. 2 layout).
+    size_t index(int face, int level, const UVec3& texel) const {
+        const size_t R = size_t(config_.resolution);
+        return (size_t(texel.z) * height() + size_t(level) * R + texel.y) * width() + size_t(face) * R + texel.x;
+    }
+    size_t index_of_voxel(int face, int level, const IVec3& v) const { return index(face, level, texel_of(v)); }
+    size_t width() const { return size_t(kFaceCount) * size_t(config_.resolution); }   // x: 6 faces
+    size_t height() const { return size_t(config_.levels) * size_t(config_.resolution); }  // y: n levels
+    size_t depth() const { return size_t(config_.resolution); }
+    size_t cell_count() const { return width() * height() * depth(); }
+
+    // ---- G-buffer
+    void clear_gbuffer(int level, const VoxelBox& box);         // box ∩ region
+    void clear_radiance(int level, const VoxelBox& box);        // both radiance buffers
+    void write(int level, const AnisotropicVoxel& voxel);       // must lie in the region
+    AnisotropicVoxel read(int level, const IVec3& v) const;     // G-buffer of one voxel
+    // Voxelizes box ∩ region of the level into the G-buffer (clearing it first).
+    FragmentVoxelizeStats voxelize(int level, const AnisotropicVoxelizer& voxelizer, const VoxelBox& box);
+    FragmentVoxelizeStats voxelize(int level, const AnisotropicVoxelizer& voxelizer) {
+        return voxelize(level, voxelizer, region(level));
+    }
+    // The cascades proper: a level voxelizes only its own part, box ∩ region minus the
+    // inner box the finer level covers (whose radiance is filtered from that level);
+    // the inner box's G-buffer is left clear. The inner box used is remembered.
+    FragmentVoxelizeStats voxelize_own(int level, const AnisotropicVoxelizer& voxelizer, const VoxelBox& box);
+    FragmentVoxelizeStats voxelize_own(int level, const AnisotropicVoxelizer& voxelizer) {
+        return voxelize_own(level, voxelizer, region(level));
+    }
+    // After the finer level moved: voxelizes what left the inner box and clears what
+    // entered it, so the level again holds exactly its own part. `exposed` (boxes a
+    // scroll just uncovered) are voxelized in the same pass, minus the inner box.
+    FragmentVoxelizeStats follow_inner(int level, const AnisotropicVoxelizer& voxelizer,
+                                       const std::vector<VoxelBox>& exposed = {});
+    bool occupied(int level, const IVec3& v) const;   // any face with opacity > 0
+    size_t occupied_voxels(int level) const;
+    // World voxel coordinates of the occupied voxels of a level inside `box`, (z, y, x) order.
+    std::vector<IVec3> occupied_in(int level, const VoxelBox& box) const;
+
+    // ---- anisotropic filtering: the inner box of `level` from level − 1 (2×2×2 → 1 per
+    // face, front-to-back along the face's axis) in one of the radiance buffers.
+    void downsample(int level, std::vector<Vec4>& buffer) const;
+
+    // ---- memory
+    size_t voxel_count() const { return size_t(config_.levels) * size_t(depth() * depth() * depth()); }
+    size_t gbuffer_bytes() const;
+    size_t radiance_bytes() const;
+    size_t bytes() const { return gbuffer_bytes() + radiance_bytes(); }
+    // What the paper's Tables 5/6 count: opacity only, one byte per voxel per face.
+    size_t opacity_bytes_paper() const { return voxel_count() * size_t(kFaceCount); }
+
+    // Attributes, one allocation each (Fig. 2 layout). G-buffer: opacity, albedo,
+    // normal, emission, position. Radiance (V-buffer), premultiplied RGBA with alpha the
+    // opacity: `direct` (direct light only) and `radiance` (direct + voxel bounce), both
+    // anisotropically filtered from finer levels.
+    std::vector<float> opacity;
+    std::vector<Vec3> albedo, normal, emission, position;
+    std::vector<Vec4> direct, radiance;
+
+private:
+    template <class Fn>
+    void for_each_run(int level, const VoxelBox& box, Fn&& fn) const;
+    CascadeConfig config_;
+    std::vector<IVec3> origins_;
+    std::vector<VoxelBox> own_inner_;  // inner box excluded by the last voxelize_own / follow_inner
+    std::vector<char> gbuffer_clear_;  // per level: nothing written since the last full clear
+};
+
+// a − b as disjoint boxes (at most six).
+std::vector<VoxelBox> subtract(const VoxelBox& a, const VoxelBox& b);
+
+// floor(a / b) for b > 0, also for negative a.
+inline int floor_div(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
+}  // namespace gilab

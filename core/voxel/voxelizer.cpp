@@ -1,0 +1,459 @@
+#include "core/voxel/voxelizer.hpp"
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <mutex>
+#include <string>
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/parallel_sort.h>
+#include "core/util/error.hpp"
+#include "core/util/morton.hpp"
+#include "core/scene/scene.hpp"
+#include "core/util/stats.hpp"
+
+namespace gilab {
+namespace {
+
+constexpr int kMaxBrickLog2 = 6;              // bricks of at most 64³ voxels (32 KiB bitmaps)
+constexpr size_t kBigBrickTriangles = 16384;  // above this a brick's triangles run in parallel
+constexpr size_t kBatchBricks = 256;          // bricks voxelized concurrently, then appended in order
+constexpr double kCoarsePad = 1e-6;  // voxels
+
+// A triangle in voxel units, prepared for many box tests: its bounding box plus the
+// ten non-trivial separating axes of Akenine-Möller's test (normal, 9 edge × axis
+// crosses) with the triangle's projected interval on each.
+struct PreparedTriangle {
+    DVec3 lo, hi;
+    int axis_count = 0;
+    DVec3 axis[10];
+    double amin[10], amax[10], radius[10];  // radius: half the projection of a unit box
+    // Plane as a height field over the dominant normal axis: w = c0 + cu·u + cv·v.
+    bool planar = false;
+    int w = 2, u = 0, v = 1;
+    double c0 = 0, cu = 0, cv = 0;
+};
+
+PreparedTriangle prepare(const DVec3& a, const DVec3& b, const DVec3& c) {
+    PreparedTriangle t;
+    t.lo = glm::min(a, glm::min(b, c));
+    t.hi = glm::max(a, glm::max(b, c));
+    DVec3 e[3] = {b - a, c - b, a - c};
+    DVec3 n = glm::cross(e[0], -e[2]);
+    auto add_axis = [&](const DVec3& ax) {
+        if (ax.x == 0 && ax.y == 0 && ax.z == 0) return;  // never separates
+        int i = t.axis_count++;
+        t.axis[i] = ax;
+        double pa = glm::dot(ax, a), pb = glm::dot(ax, b), pc = glm::dot(ax, c);
+        t.amin[i] = std::min(pa, std::min(pb, pc));
+        t.amax[i] = std::max(pa, std::max(pb, pc));
+        t.radius[i] = 0.5 * (std::abs(ax.x) + std::abs(ax.y) + std::abs(ax.z));
+    };
+    add_axis(n);
+    for (const DVec3& edge : e) {
+        add_axis({0, -edge.z, edge.y});  // edge × x
+        add_axis({edge.z, 0, -edge.x});  // edge × y
+        add_axis({-edge.y, edge.x, 0});  // edge × z
+    }
+    DVec3 an = glm::abs(n);
+    t.w = an.x >= an.y && an.x >= an.z ? 0 : (an.y >= an.z ? 1 : 2);
+    t.u = (t.w + 1) % 3;
+    t.v = (t.w + 2) % 3;
+    double longest = std::max(glm::dot(e[0], e[0]), std::max(glm::dot(e[1], e[1]), glm::dot(e[2], e[2])));
+    // A well-shaped plane gives each column a tight height range; slivers whose normal
+    // is lost in rounding fall back to their whole bounding box.
+    t.planar = an[t.w] > 1e-7 * longest && longest > 0;
+    if (t.planar) {
+        t.cu = -n[t.u] / n[t.w];
+        t.cv = -n[t.v] / n[t.w];
+        t.c0 = a[t.w] - t.cu * a[t.u] - t.cv * a[t.v];
+    }
+    return t;
+}
+
+// Closed box [bmin, bmin + size] against the triangle; touching counts as overlap.
+inline bool overlaps(const PreparedTriangle& t, const DVec3& bmin, double size) {
+    const DVec3 bmax = bmin + DVec3(size);
+    if (t.lo.x > bmax.x || t.lo.y > bmax.y || t.lo.z > bmax.z || t.hi.x < bmin.x ||
+        t.hi.y < bmin.y || t.hi.z < bmin.z)
+        return false;
+    DVec3 center = bmin + DVec3(0.5 * size);
+    for (int i = 0; i < t.axis_count; ++i) {
+        double s = glm::dot(t.axis[i], center);
+        double r = t.radius[i] * size;
+        if (t.amin[i] > s + r || t.amax[i] < s - r) return false;
+    }
+    return true;
+}
+
+struct CellBox {  // half-open cell index ranges
+    int64_t lo[3];
+    int64_t hi[3];
+};
+
+inline int64_t clamp_to_index(double x, int64_t lo, int64_t hi) {
+    return static_cast<int64_t>(std::clamp(x, double(lo), double(hi)));
+}
+
+// Calls emit(x, y, z) for every cell of 2^log2 voxels inside `clip` that the triangle
+// overlaps, each cell grown by `pad` on every side (coarse cells are padded so they
+// never miss a voxel that the exact per-voxel test accepts). Candidates per column of
+// the dominant-axis projection come from the plane's height range over the column;
+// each candidate is then tested exactly.
+template <class Emit>
+void rasterize(const PreparedTriangle& t, int log2, double pad, const CellBox& clip, uint64_t& tests, Emit&& emit) {
+    const double s = std::ldexp(1.0, log2);
+    const double inv = 1.0 / s;
+    int64_t lo[3], hi[3];
+    for (int i = 0; i < 3; ++i) {
+        // Cell k (span [k·s, (k+1)·s]) touches [lo, hi] iff lo/s − 1 ≤ k ≤ hi/s.
+        lo[i] = std::max(clip.lo[i], clamp_to_index(std::ceil((t.lo[i] - pad) * inv - 1.0), clip.lo[i] - 1, clip.hi[i] + 1));
+        hi[i] = std::min(clip.hi[i] - 1, clamp_to_index(std::floor((t.hi[i] + pad) * inv), clip.lo[i] - 1, clip.hi[i] + 1));
+        if (lo[i] > hi[i]) return;
+    }
+    int64_t cell[3];
+    auto test = [&](int64_t x, int64_t y, int64_t z) {
+        ++tests;
+        if (overlaps(t, DVec3(double(x), double(y), double(z)) * s - DVec3(pad), s + 2 * pad)) emit(x, y, z);
+    };
+    if (!t.planar) {
+        for (int64_t z = lo[2]; z <= hi[2]; ++z)
+            for (int64_t y = lo[1]; y <= hi[1]; ++y)
+                for (int64_t x = lo[0]; x <= hi[0]; ++x) test(x, y, z);
+        return;
+    }
+    const int u = t.u, v = t.v, w = t.w;
+    constexpr double kEps = 1e-6;
+    for (int64_t b = lo[v]; b <= hi[v]; ++b) {
+        double v0 = double(b) * s - pad, v1 = double(b + 1) * s + pad;
+        double hv_min = t.cv >= 0 ? t.cv * v0 : t.cv * v1;
+        double hv_max = t.cv >= 0 ? t.cv * v1 : t.cv * v0;
+        for (int64_t a = lo[u]; a <= hi[u]; ++a) {
+            double u0 = double(a) * s - pad, u1 = double(a + 1) * s + pad;
+            double zmin = t.c0 + hv_min + (t.cu >= 0 ? t.cu * u0 : t.cu * u1);
+            double zmax = t.c0 + hv_max + (t.cu >= 0 ? t.cu * u1 : t.cu * u0);
+            zmin = std::max(zmin, t.lo[w]) - pad;
+            zmax = std::min(zmax, t.hi[w]) + pad;
+            int64_t k0 = std::max(lo[w], clamp_to_index(std::ceil(zmin * inv - 1.0 - kEps), lo[w] - 1, hi[w] + 1));
+            int64_t k1 = std::min(hi[w], clamp_to_index(std::floor(zmax * inv + kEps), lo[w] - 1, hi[w] + 1));
+            cell[u] = a;
+            cell[v] = b;
+            for (int64_t k = k0; k <= k1; ++k) {
+                cell[w] = k;
+                test(cell[0], cell[1], cell[2]);
+            }
+        }
+    }
+}
+
+// Brick bitmaps are recycled through a small pool (not thread-local storage: nested
+// parallel loops may run another brick on the same thread).
+class BitmapPool {
+public:
+    explicit BitmapPool(size_t words) : words_(words) {}
+    std::vector<uint64_t> take() {
+        std::lock_guard lock(mutex_);
+        if (free_.empty()) return std::vector<uint64_t>(words_, 0);
+        auto v = std::move(free_.back());
+        free_.pop_back();
+        return v;
+    }
+    void give(std::vector<uint64_t> v) {
+        std::lock_guard lock(mutex_);
+        free_.push_back(std::move(v));
+    }
+
+private:
+    size_t words_;
+    std::mutex mutex_;
+    std::vector<std::vector<uint64_t>> free_;
+};
+
+std::string gib(double bytes) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.2f GiB", bytes / double(1ull << 30));
+    return buf;
+}
+
+}  // namespace
+
+UVec3 VoxelList::voxel(size_t i) const { return morton_decode(codes[i]); }
+
+struct Voxelizer::Impl {
+    VoxelGrid grid;
+    VoxelizeOptions options;
+    std::vector<PreparedTriangle> triangles;  // in voxel units
+    std::vector<double> estimate;             // per triangle, voxels
+
+    void init(std::span<const Vec3> positions, std::span<const UVec3> tris);
+    VoxelList run(VoxelRegion region) const;
+    uint64_t estimate_in(const VoxelRegion& region) const;
+};
+
+void Voxelizer::Impl::init(std::span<const Vec3> positions, std::span<const UVec3> tris) {
+    grid.validate("voxelizer");
+    if (tris.empty()) throw Error("voxelizer", "nothing to voxelize: the input has no triangles");
+    for (size_t i = 0; i < positions.size(); ++i)
+        if (!is_finite(positions[i]))
+            throw Error("voxelizer", "vertex " + std::to_string(i) + " has a non-finite position");
+    for (size_t i = 0; i < tris.size(); ++i)
+        for (int k = 0; k < 3; ++k)
+            if (tris[i][k] >= positions.size())
+                throw Error("voxelizer", "triangle " + std::to_string(i) + " refers to vertex " +
+                                             std::to_string(tris[i][k]) + " but there are only " +
+                                             std::to_string(positions.size()) + " vertices");
+    triangles.resize(tris.size());
+    estimate.resize(tris.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, tris.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i) {
+            DVec3 a = grid.to_voxel_space(positions[tris[i].x]);
+            DVec3 b = grid.to_voxel_space(positions[tris[i].y]);
+            DVec3 c = grid.to_voxel_space(positions[tris[i].z]);
+            triangles[i] = prepare(a, b, c);
+            // Voxels a plane crosses per unit area = L1 norm of its unit normal, so the
+            // projected areas on the three axes count the interior; edges add a border.
+            DVec3 n = glm::abs(glm::cross(b - a, c - a));
+            auto l1 = [](const DVec3& d) { return std::abs(d.x) + std::abs(d.y) + std::abs(d.z); };
+            estimate[i] = 0.5 * (n.x + n.y + n.z) + l1(b - a) + l1(c - b) + l1(a - c) + 8.0;
+        }
+    });
+}
+
+uint64_t Voxelizer::Impl::estimate_in(const VoxelRegion& region) const {
+    if (region.empty()) return 0;
+    double total = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, triangles.size(), 4096), 0.0,
+        [&](const tbb::blocked_range<size_t>& r, double sum) {
+            for (size_t i = r.begin(); i < r.end(); ++i) {
+                const PreparedTriangle& t = triangles[i];
+                double cells = 1;
+                for (int k = 0; k < 3; ++k) {
+                    double lo = std::max(std::ceil(t.lo[k] - 1.0), double(region.begin[k]));
+                    double hi = std::min(std::floor(t.hi[k]), double(region.end[k]) - 1.0);
+                    cells *= std::max(0.0, hi - lo + 1.0);
+                }
+                sum += std::min(cells, estimate[i]);
+            }
+            return sum;
+        },
+        std::plus<double>());
+    return static_cast<uint64_t>(std::min(total, double(region.volume())));
+}
+
+VoxelList Voxelizer::Impl::run(VoxelRegion region) const {
+    Stopwatch clock;
+    VoxelList out;
+    out.grid = grid;
+    region = region.intersect(grid.full_region());
+    if (region.empty()) return out;
+
+    const uint64_t estimated = estimate_in(region);
+    out.stats.estimated_voxels = estimated;
+    if (double(estimated) * 8.0 > double(options.max_bytes))
+        throw Error("voxelizer", "resolution " + std::to_string(grid.resolution) + " would give about " +
+                                     std::to_string(estimated) + " voxels (" + gib(double(estimated) * 8.0) +
+                                     "), more than the memory budget of " + gib(double(options.max_bytes)) +
+                                     "; use a lower resolution or a split build over sub-regions");
+
+    const int brick_log2 = std::min(grid.depth(), kMaxBrickLog2);
+    const int64_t brick = int64_t(1) << brick_log2;
+    CellBox brick_clip, voxel_clip;
+    for (int k = 0; k < 3; ++k) {
+        voxel_clip.lo[k] = region.begin[k];
+        voxel_clip.hi[k] = region.end[k];
+        brick_clip.lo[k] = region.begin[k] >> brick_log2;
+        brick_clip.hi[k] = ((region.end[k] - 1) >> brick_log2) + 1;
+    }
+
+    // 1. (brick, triangle) pairs, sorted by brick Morton code then triangle.
+    struct Pair {
+        uint64_t brick;
+        uint32_t triangle;
+        bool operator<(const Pair& o) const { return brick != o.brick ? brick < o.brick : triangle < o.triangle; }
+    };
+    tbb::enumerable_thread_specific<std::vector<Pair>> local_pairs;
+    std::atomic<uint64_t> tests_total{0}, triangles_used{0};
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+        auto& pairs = local_pairs.local();
+        uint64_t tests = 0, used = 0;
+        for (size_t i = r.begin(); i < r.end(); ++i) {
+            size_t before = pairs.size();
+            rasterize(triangles[i], brick_log2, kCoarsePad, brick_clip, tests, [&](int64_t x, int64_t y, int64_t z) {
+                pairs.push_back({morton_encode(uint32_t(x), uint32_t(y), uint32_t(z)), uint32_t(i)});
+            });
+            used += pairs.size() != before;
+        }
+        tests_total += tests;
+        triangles_used += used;
+    });
+    std::vector<Pair> pairs;
+    for (auto& p : local_pairs) pairs.insert(pairs.end(), p.begin(), p.end());
+    local_pairs.clear();
+    tbb::parallel_sort(pairs.begin(), pairs.end());
+    std::vector<size_t> group_begin;  // pairs of one brick are contiguous
+    for (size_t i = 0; i < pairs.size(); ++i)
+        if (i == 0 || pairs[i].brick != pairs[i - 1].brick) group_begin.push_back(i);
+    group_begin.push_back(pairs.size());
+    const size_t groups = group_begin.size() - 1;
+    out.stats.triangles = triangles_used;
+    out.stats.bricks = groups;
+
+    // 2. Each brick: mark overlapped voxels in a bitmap indexed by local Morton code,
+    // then read it in order — sorted, unique output without a global sort.
+    const size_t bitmap_words = std::max<size_t>(1, (size_t(1) << (3 * brick_log2)) / 64);
+    BitmapPool pool(bitmap_words);
+    out.codes.reserve(estimated);
+    auto fill_brick = [&](size_t g, std::vector<uint64_t>& bitmap, bool parallel) {
+        const uint64_t key = pairs[group_begin[g]].brick;
+        const UVec3 bc = morton_decode(key);
+        CellBox clip;
+        for (int k = 0; k < 3; ++k) {
+            clip.lo[k] = std::max<int64_t>(voxel_clip.lo[k], int64_t(bc[k]) * brick);
+            clip.hi[k] = std::min<int64_t>(voxel_clip.hi[k], int64_t(bc[k] + 1) * brick);
+        }
+        const uint32_t bx = bc.x * uint32_t(brick), by = bc.y * uint32_t(brick), bz = bc.z * uint32_t(brick);
+        auto run_range = [&](size_t p0, size_t p1, auto set_bit) {
+            uint64_t tests = 0;
+            for (size_t p = p0; p < p1; ++p)
+                rasterize(triangles[pairs[p].triangle], 0, 0.0, clip, tests, [&](int64_t x, int64_t y, int64_t z) {
+                    uint64_t local = morton_encode(uint32_t(x) - bx, uint32_t(y) - by, uint32_t(z) - bz);
+                    set_bit(local >> 6, uint64_t(1) << (local & 63));
+                });
+            tests_total += tests;
+        };
+        if (parallel) {
+            tbb::parallel_for(tbb::blocked_range<size_t>(group_begin[g], group_begin[g + 1], 64),
+                              [&](const tbb::blocked_range<size_t>& r) {
+                                  run_range(r.begin(), r.end(), [&](uint64_t word, uint64_t bit) {
+                                      std::atomic_ref<uint64_t>(bitmap[word]).fetch_or(bit, std::memory_order_relaxed);
+                                  });
+                              });
+        } else {
+            run_range(group_begin[g], group_begin[g + 1], [&](uint64_t word, uint64_t bit) { bitmap[word] |= bit; });
+        }
+    };
+    auto drain = [&](size_t g, std::vector<uint64_t>& bitmap, std::vector<uint64_t>& codes) {
+        const uint64_t base = pairs[group_begin[g]].brick << (3 * brick_log2);
+        for (size_t i = 0; i < bitmap.size(); ++i) {
+            uint64_t word = bitmap[i];
+            if (!word) continue;
+            bitmap[i] = 0;  // leave the bitmap clean for reuse
+            while (word) {
+                codes.push_back(base | (uint64_t(i) << 6 | uint64_t(std::countr_zero(word))));
+                word &= word - 1;
+            }
+        }
+    };
+
+    size_t g = 0;
+    while (g < groups) {
+        size_t size = group_begin[g + 1] - group_begin[g];
+        if (size >= kBigBrickTriangles) {
+            auto bitmap = pool.take();
+            fill_brick(g, bitmap, true);
+            drain(g, bitmap, out.codes);
+            pool.give(std::move(bitmap));
+            ++g;
+            continue;
+        }
+        size_t end = g;
+        while (end < groups && end - g < kBatchBricks && group_begin[end + 1] - group_begin[end] < kBigBrickTriangles) ++end;
+        std::vector<std::vector<uint64_t>> results(end - g);
+        tbb::parallel_for(tbb::blocked_range<size_t>(g, end, 1), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i < r.end(); ++i) {
+                auto bitmap = pool.take();
+                fill_brick(i, bitmap, false);
+                drain(i, bitmap, results[i - g]);
+                pool.give(std::move(bitmap));
+            }
+        });
+        for (auto& codes : results) out.codes.insert(out.codes.end(), codes.begin(), codes.end());
+        g = end;
+    }
+    out.stats.box_tests = tests_total;
+    out.stats.ms = clock.elapsed_ms();
+    return out;
+}
+
+Voxelizer::Voxelizer(std::span<const Vec3> positions, std::span<const UVec3> triangles, const VoxelGrid& grid,
+                     VoxelizeOptions options)
+    : impl_(std::make_unique<Impl>()) {
+    impl_->grid = grid;
+    impl_->options = options;
+    impl_->init(positions, triangles);
+}
+
+Voxelizer::Voxelizer(const SceneFrame& frame, const VoxelGrid& grid, VoxelizeOptions options)
+    : impl_(std::make_unique<Impl>()) {
+    impl_->grid = grid;
+    impl_->options = options;
+    std::vector<Vec3> positions;
+    std::vector<UVec3> triangles;
+    for (size_t m = 0; m < frame.meshes.size(); ++m) {
+        const WorldMesh& mesh = frame.meshes[m];
+        uint32_t base = static_cast<uint32_t>(positions.size());
+        for (const UVec3& t : mesh.triangles) {
+            for (int k = 0; k < 3; ++k)
+                if (t[k] >= mesh.positions.size())
+                    throw Error("voxelizer", "mesh " + std::to_string(m) + " has a triangle referring to vertex " +
+                                                 std::to_string(t[k]) + " of " +
+                                                 std::to_string(mesh.positions.size()));
+            triangles.push_back(t + UVec3(base));
+        }
+        positions.insert(positions.end(), mesh.positions.begin(), mesh.positions.end());
+    }
+    impl_->init(positions, triangles);
+}
+
+Voxelizer::~Voxelizer() = default;
+Voxelizer::Voxelizer(Voxelizer&&) noexcept = default;
+Voxelizer& Voxelizer::operator=(Voxelizer&&) noexcept = default;
+
+const VoxelGrid& Voxelizer::grid() const { return impl_->grid; }
+const VoxelizeOptions& Voxelizer::options() const { return impl_->options; }
+size_t Voxelizer::triangle_count() const { return impl_->triangles.size(); }
+VoxelList Voxelizer::voxelize() const { return impl_->run(impl_->grid.full_region()); }
+VoxelList Voxelizer::voxelize(const VoxelRegion& region) const { return impl_->run(region); }
+uint64_t Voxelizer::estimate_voxels(const VoxelRegion& region) const {
+    return impl_->estimate_in(region.intersect(impl_->grid.full_region()));
+}
+
+std::vector<uint64_t> Voxelizer::touched_cells(int cell_log2) const {
+    const VoxelGrid& grid = impl_->grid;
+    cell_log2 = std::clamp(cell_log2, 0, grid.depth());
+    CellBox clip;
+    for (int k = 0; k < 3; ++k) {
+        clip.lo[k] = 0;
+        clip.hi[k] = ((int64_t(grid.resolution) - 1) >> cell_log2) + 1;
+    }
+    tbb::enumerable_thread_specific<std::vector<uint64_t>> local;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, impl_->triangles.size(), 256),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          auto& cells = local.local();
+                          uint64_t tests = 0;
+                          for (size_t i = r.begin(); i < r.end(); ++i)
+                              rasterize(impl_->triangles[i], cell_log2, kCoarsePad, clip, tests,
+                                        [&](int64_t x, int64_t y, int64_t z) {
+                                            cells.push_back(morton_encode(uint32_t(x), uint32_t(y), uint32_t(z)));
+                                        });
+                      });
+    std::vector<uint64_t> cells;
+    for (auto& c : local) cells.insert(cells.end(), c.begin(), c.end());
+    tbb::parallel_sort(cells.begin(), cells.end());
+    cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+    return cells;
+}
+
+VoxelList voxelize(std::span<const Vec3> positions, std::span<const UVec3> triangles, const VoxelGrid& grid,
+                   VoxelizeOptions options) {
+    return Voxelizer(positions, triangles, grid, options).voxelize();
+}
+
+VoxelList voxelize(const SceneFrame& frame, const VoxelGrid& grid, VoxelizeOptions options) {
+    return Voxelizer(frame, grid, options).voxelize();
+}
+
+}  // namespace gilab

@@ -1,0 +1,82 @@
+#pragma once
+// Conservative surface voxelization: a voxel is occupied when its closed box overlaps a
+// triangle (Akenine-Möller's separating-axis triangle/box test). The output is the
+// Morton-sorted list of unique occupied voxel coordinates, identical at any thread
+// count. Work streams over aligned bricks of at most 64³ voxels, so memory is the
+// output list plus a few brick bitmaps — never resolution³. A sub-region of the grid
+// can be voxelized alone (cascades, and split builds that go one octree subtree at a time).
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+#include "core/util/math.hpp"
+#include "core/voxel/voxel_grid.hpp"
+
+namespace gilab {
+
+struct SceneFrame;
+
+struct VoxelizeOptions {
+    // Output budget: a call whose estimated voxel count × 8 bytes exceeds it throws
+    // Error before allocating anything.
+    size_t max_bytes = size_t(4) << 30;
+};
+
+struct VoxelizeStats {
+    double ms = 0;                   // wall time of the call
+    uint64_t estimated_voxels = 0;   // the estimate checked against the budget
+    uint64_t triangles = 0;          // triangles whose bounding box meets the region
+    uint64_t bricks = 0;             // bricks with at least one triangle
+    uint64_t box_tests = 0;          // triangle/voxel tests run
+};
+
+struct VoxelList {
+    VoxelGrid grid;
+    std::vector<uint64_t> codes;     // Morton codes (core/util/morton.hpp), ascending, unique
+    VoxelizeStats stats;
+
+    size_t size() const { return codes.size(); }
+    bool empty() const { return codes.empty(); }
+    UVec3 voxel(size_t i) const;
+};
+
+class Voxelizer {
+public:
+    // Triangles index `positions`. Throws Error for a bad grid (resolution 0 or above
+    // 2^21), no triangles, out-of-range indices or non-finite positions.
+    Voxelizer(std::span<const Vec3> positions, std::span<const UVec3> triangles,
+              const VoxelGrid& grid, VoxelizeOptions options = {});
+    // Every mesh of a world-space scene frame.
+    Voxelizer(const SceneFrame& frame, const VoxelGrid& grid, VoxelizeOptions options = {});
+    ~Voxelizer();
+    Voxelizer(Voxelizer&&) noexcept;
+    Voxelizer& operator=(Voxelizer&&) noexcept;
+
+    const VoxelGrid& grid() const;
+    const VoxelizeOptions& options() const;
+    size_t triangle_count() const;
+
+    // All voxels of the grid / only those inside `region` (clamped to the grid).
+    // Throws Error when the estimate exceeds options().max_bytes.
+    VoxelList voxelize() const;
+    VoxelList voxelize(const VoxelRegion& region) const;
+
+    // Estimate of the occupied voxels inside a region: projected triangle areas plus
+    // edge lengths, in voxels, capped by the region volume. On smooth meshes it is
+    // about twice the true count (shared edges and voxels are counted per triangle).
+    uint64_t estimate_voxels(const VoxelRegion& region) const;
+    // Aligned cells of 2^cell_log2 voxels per axis that some triangle overlaps, as the
+    // Morton codes of the cell coordinates (cell = voxel >> cell_log2), ascending.
+    std::vector<uint64_t> touched_cells(int cell_log2) const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+// One-call forms.
+VoxelList voxelize(std::span<const Vec3> positions, std::span<const UVec3> triangles,
+                   const VoxelGrid& grid, VoxelizeOptions options = {});
+VoxelList voxelize(const SceneFrame& frame, const VoxelGrid& grid, VoxelizeOptions options = {});
+
+}  // namespace gilab

@@ -1,0 +1,222 @@
+// The P3 cascaded-VCT experiments in quick mode: each one runs and writes every column
+// of every row; the memory tables charge each structure its real encoding, in MB of
+// 10⁶ B (the paper's are 2²⁰ B, so its 3D texture at 128³ prints as 2 where ours is
+// 2.097); sizes fixed by construction (the 3D texture and the cascades) come out exactly
+// and are marked as such; no note states a target.
+#include <gtest/gtest.h>
+#include <cmath>
+#include <map>
+#include <set>
+#include <string>
+#include "core/util/error.hpp"
+#include "experiments/runner/experiment.hpp"
+#include "tests/experiment_test_support.hpp"
+
+namespace {
+
+using namespace gilab;
+using nlohmann::json;
+
+const ExperimentRegistry& vct_registry() {
+    static const ExperimentRegistry registry = test::registry_with({register_vct_experiments});
+    return registry;
+}
+
+// The VCT experiments measure the Stanford models in the Cornell box and Sponza; without
+// the shared assets they have nothing to run on.
+bool assets_missing() {
+    return !test::shared_asset("bunny/stanford-bunny.obj") || !test::shared_asset("sponza/sponza.obj");
+}
+
+template <class Base>
+class NeedsAssets : public Base {
+protected:
+    void SetUp() override {
+        if (assets_missing()) GTEST_SKIP() << "the bunny or Sponza is not in the shared scenes (set GILAB_ASSETS)";
+    }
+};
+using VctExperiments = NeedsAssets<testing::Test>;
+
+int resolution_of(const json& row) { return std::stoi(row.at("resolution").get<std::string>()); }
+
+class VctQuickExperiment : public NeedsAssets<testing::TestWithParam<const char*>> {};
+
+TEST_P(VctQuickExperiment, RunsAndFillsEveryColumnWithoutTargets) {
+    const ExperimentOutput out = test::run_quick_experiment(vct_registry(), GetParam());
+    for (const std::string& note : out.notes) EXPECT_EQ(note.find("Target"), std::string::npos) << note;
+}
+
+INSTANTIATE_TEST_SUITE_P(All, VctQuickExperiment,
+                         testing::Values("vct-table1", "vct-table2", "vct-table3", "vct-table4", "vct-table5",
+                                         "vct-table6", "vct-table7", "vct-fig9", "vct-fig10", "vct-fig11",
+                                         "vct-fig12-13", "vct-stability"),
+                         test::test_name_of);
+
+TEST_F(VctExperiments, MemoryChargesEachStructureItsRealEncodingInMegabytesOfTenToTheSixBytes) {
+    const ExperimentOutput out = test::run_quick_experiment(vct_registry(), "vct-table5");
+    const ResultTable& t = out.tables.at(0);
+    int checked = 0, paper_checked = 0;
+    for (const json& row : t.rows) {
+        const double n = resolution_of(row);
+        const std::string structure = row.at("structure");
+        const double memory = row.at("memory (MB, real encoding)").get<double>();
+        const double count = row.at("nodes or cells (×10⁶)").get<double>();
+        const double per_node = row.at("bytes per node or cell").get<double>();
+        EXPECT_NEAR(memory, count * per_node, 1e-9 * memory) << row.dump();
+        EXPECT_LE(memory, row.at("all arrays held (MB)").get<double>() * (1 + 1e-12)) << row.dump();
+        // The paper's accounting, 1 B per voxel face, applied to every structure alike.
+        const double paper_accounting =
+            row.at("memory, paper's accounting: 1 B per face × 6 faces per node or cell (MB)").get<double>();
+        EXPECT_NEAR(paper_accounting, 6 * count, 1e-9 * paper_accounting) << row.dump();
+        if (structure == "cascaded") {
+            EXPECT_DOUBLE_EQ(paper_accounting, (std::log2(n / 32.0) + 1) * 32 * 32 * 32 * 6 / 1e6) << row.dump();
+        }
+        const std::string fixed = row.at("fixed by construction").get<std::string>();
+        EXPECT_EQ(fixed.rfind("yes", 0) == 0, structure == "3D texture" || structure == "cascaded") << row.dump();
+        if (structure == "3D texture") {
+            EXPECT_DOUBLE_EQ(memory, n * n * n / 1e6);  // one byte per cell
+            if (n == 128) {
+                EXPECT_EQ(row.at("paper memory (MiB, printed as MB)").get<double>(), 2.0);
+            }
+            ++checked;
+        } else if (structure == "cascaded") {
+            const double levels = std::log2(n / 32.0) + 1;  // 32³ per level, finest voxel = the grid's
+            EXPECT_DOUBLE_EQ(memory, levels * 32 * 32 * 32 * 6 * 4 / 1e6);  // a float per face
+            ++checked;
+        } else if (structure == "SVO") {
+            // A mask byte per node, a 4-byte index per node with children: more than 1 B
+            // (what the table charged before) and at most 5 B per node.
+            EXPECT_GT(per_node, 1.0) << row.dump();
+            EXPECT_LE(per_node, 5.0) << row.dump();
+            ++checked;
+        } else if (structure == "SVDAG") {
+            EXPECT_GE(per_node, 4.0) << row.dump();  // at least the mask word
+            ++checked;
+        }
+        // The paper's bytes per node follow from its own memory and count (bunny, 128³).
+        if (row.at("scene") == "cornell+bunny" && n == 128 && structure == "SVO") {
+            EXPECT_NEAR(row.at("paper bytes per node or cell (paper MiB × 2²⁰ ÷ paper count)").get<double>(),
+                        1.584 * 1048576.0 / 0.189e6, 1e-9);
+            ++paper_checked;
+        }
+    }
+    EXPECT_GE(checked, 8);
+    EXPECT_EQ(paper_checked, 1);
+}
+
+}  // namespace
+
+namespace {
+
+// Tables 3–4 time every structure from both voxelizers, except the cascades, which need
+// the fragment voxelizer's per-face attributes.
+TEST_F(VctExperiments, EveryStructureIsTimedFromBothVoxelizers) {
+    const ExperimentOutput out = test::run_quick_experiment(vct_registry(), "vct-table3");
+    int rows = 0;
+    for (const json& row : out.tables.at(0).rows) {
+        const json& overlap = row.at("voxelize_ms (overlap voxelizer)");
+        const json& fragment = row.at("voxelize_ms (fragment voxelizer)");
+        ASSERT_TRUE(fragment.is_number()) << row.dump();
+        EXPECT_GT(fragment.get<double>(), 0.0);
+        if (row.at("structure") == "cascaded") {
+            EXPECT_TRUE(overlap.is_null()) << row.dump();
+        } else {
+            ASSERT_TRUE(overlap.is_number()) << row.dump();
+            EXPECT_GT(overlap.get<double>(), 0.0);
+        }
+        ++rows;
+    }
+    EXPECT_GE(rows, 6);
+}
+
+
+// P3 measures Sponza and Sibenik (Tables 2, 4, 6 and the walks of Figs. 9–10); the walk
+// has the photon-mapping curve beside the cone-traced variants.
+TEST_F(VctExperiments, SibenikStandsBesideSponzaAndTheWalkHasThePhotonCurve) {
+    const bool sibenik = test::shared_asset("sibenik/sibenik.obj").has_value();
+    const ExperimentOutput table2 = test::run_quick_experiment(vct_registry(), "vct-table2");
+    int sibenik_rows = 0;
+    for (const json& row : table2.tables.at(0).rows) {
+        if (row.at("scene") != "sibenik") continue;
+        ++sibenik_rows;
+        if (resolution_of(row) != 256) continue;
+        if (row.at("structure") == "3D texture") {
+            EXPECT_EQ(row.at("paper voxels_millions").get<double>(), 16.78);
+        } else if (row.at("structure") == "SVO") {
+            EXPECT_EQ(row.at("paper voxels_millions").get<double>(), 2.916);
+        }
+    }
+    EXPECT_EQ(sibenik_rows, sibenik ? 12 : 0);  // 6 structures × 2 resolutions
+
+    const ExperimentOutput fig9 = test::run_quick_experiment(vct_registry(), "vct-fig9");
+    std::map<std::string, std::set<std::string>> variants;
+    for (const json& row : fig9.tables.back().rows) {
+        if (!row.at("frame_ms").is_number()) continue;  // the update ratio row
+        EXPECT_GT(row.at("frame_ms").get<double>(), 0.0) << row.dump();
+        variants[row.at("scene")].insert(row.at("variant"));
+    }
+    const std::set<std::string> expected = {"dense mip", "cascaded, update everything", "cascaded, update strategy",
+                                            "photon mapping"};
+    EXPECT_EQ(variants["sponza"], expected);
+    if (sibenik) {
+        EXPECT_EQ(variants["sibenik"], expected);
+    }
+    EXPECT_EQ(variants.size(), sibenik ? 2u : 1u);
+    // Figs. 9 and 10 are plots in the paper: one curve per variant along each walk.
+    const ExperimentOutput fig10 = test::run_quick_experiment(vct_registry(), "vct-fig10");
+    for (const ExperimentOutput* out : {&fig9, &fig10}) {
+        EXPECT_EQ(out->plots.size(), variants.size());
+        for (const auto& [name, plot] : out->plots) {
+            ASSERT_EQ(plot.series.size(), 4u) << name;
+            for (const auto& series : plot.series) {
+                EXPECT_EQ(series.x.size(), fig9.tables.at(0).rows.size()) << name << " " << series.label;
+                EXPECT_EQ(variants.begin()->second.count(series.label), 1u) << series.label;
+            }
+        }
+    }
+}
+
+}  // namespace
+
+namespace {
+
+using namespace gilab;
+using nlohmann::json;
+
+ExperimentOutput run_quick(const std::string& name, uint64_t seed, const AssetPaths& assets) {
+    ExperimentContext ctx;
+    ctx.quick = true;
+    ctx.seed = seed;
+    ctx.assets = assets;
+    ctx.output_dir = test::temp_dir("vct_cache_" + name + "_" + std::to_string(seed));
+    return run_and_write(vct_registry().get(name), ctx);
+}
+
+double photon_map_mb(const ExperimentOutput& fig10, const std::string& scene) {
+    for (const json& row : fig10.tables.back().rows)
+        if (row.at("scene") == scene && row.at("variant") == "photon mapping")
+            return row.at("mean structure (MB)").get<double>();
+    ADD_FAILURE() << "no photon mapping row for " << scene;
+    return 0;
+}
+
+// The structure tables keep their measurements for the process (Tables 1, 3, 5 share one
+// run); a second run whose scene files are not there must not print the first run's.
+TEST_F(VctExperiments, ASecondRunWithOtherAssetsDoesNotReturnTheFirstRunsFigures) {
+    (void)run_quick("vct-table1", 1, AssetPaths::from_environment());
+    const AssetPaths empty({test::temp_dir("vct_cache_no_assets")});
+    EXPECT_THROW((void)run_quick("vct-table1", 1, empty), Error);
+}
+
+// The walks of Figs. 9–10 are kept for the process too; the photon map holds the photons
+// a seed stores, so a second seed must give that seed's memory, the same seed the same.
+TEST_F(VctExperiments, ASecondRunWithAnotherSeedGivesItsOwnFigures) {
+    const AssetPaths assets = AssetPaths::from_environment();
+    const double first = photon_map_mb(run_quick("vct-fig10", 11, assets), "sponza");
+    const double second = photon_map_mb(run_quick("vct-fig10", 12, assets), "sponza");
+    const double first_again = photon_map_mb(run_quick("vct-fig10", 11, assets), "sponza");
+    EXPECT_NE(first, second);
+    EXPECT_EQ(first, first_again);
+}
+
+}  // namespace
