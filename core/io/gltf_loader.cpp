@@ -202,6 +202,17 @@ std::vector<uint16_t> read_joints(const Context& ctx, int index, const std::stri
     return std::vector<uint16_t>(f.begin(), f.end());  // exact: at most 65535
 }
 
+// A node's translation, rotation and scale (glTF's default for each part it leaves out).
+Transform node_trs(const tinygltf::Node& n) {
+    Transform t;
+    if (n.translation.size() == 3) t.translation = Vec3(n.translation[0], n.translation[1], n.translation[2]);
+    if (n.rotation.size() == 4)
+        t.rotation = glm::normalize(Quat(float(n.rotation[3]), float(n.rotation[0]), float(n.rotation[1]),
+                                         float(n.rotation[2])));
+    if (n.scale.size() == 3) t.scale = Vec3(n.scale[0], n.scale[1], n.scale[2]);
+    return t;
+}
+
 Mat4 node_local_matrix(const tinygltf::Node& n) {
     if (n.matrix.size() == 16) {
         Mat4 m;
@@ -209,13 +220,7 @@ Mat4 node_local_matrix(const tinygltf::Node& n) {
             for (int r = 0; r < 4; ++r) m[c][r] = float(n.matrix[size_t(c * 4 + r)]);
         return m;
     }
-    Transform t;
-    if (n.translation.size() == 3) t.translation = Vec3(n.translation[0], n.translation[1], n.translation[2]);
-    if (n.rotation.size() == 4)
-        t.rotation = glm::normalize(Quat(float(n.rotation[3]), float(n.rotation[0]), float(n.rotation[1]),
-                                         float(n.rotation[2])));
-    if (n.scale.size() == 3) t.scale = Vec3(n.scale[0], n.scale[1], n.scale[2]);
-    return t.matrix();
+    return node_trs(n).matrix();
 }
 
 // Values are used in single precision: 1e300 would become infinity on the way.
@@ -233,13 +238,7 @@ void check_node_transform(const std::string& file, int index, const tinygltf::No
 
 Transform node_local_transform(const tinygltf::Node& n) {
     if (n.matrix.size() == 16) return Transform::from_matrix(node_local_matrix(n));
-    Transform t;
-    if (n.translation.size() == 3) t.translation = Vec3(n.translation[0], n.translation[1], n.translation[2]);
-    if (n.rotation.size() == 4)
-        t.rotation = glm::normalize(Quat(float(n.rotation[3]), float(n.rotation[0]), float(n.rotation[1]),
-                                         float(n.rotation[2])));
-    if (n.scale.size() == 3) t.scale = Vec3(n.scale[0], n.scale[1], n.scale[2]);
-    return t;
+    return node_trs(n);
 }
 
 // KHR_lights_punctual numbers are checked like the scene file's own: a negative colour

@@ -116,7 +116,9 @@ TEST_P(ShippedScene, DefaultRenderOfEachTechniqueIsSensible) {
     try {
         opened = open_scene(name, AssetPaths::from_environment());
     } catch (const Error& e) {
-        if (std::string(e.what()).find("not found") != std::string::npos) GTEST_SKIP() << name << ": " << e.what();
+        if (std::string(e.what()).find("not found") != std::string::npos) {
+            GTEST_SKIP() << name << ": " << e.what();
+        }
         throw;
     }
     const Scene& scene = opened.scene;
