@@ -549,7 +549,9 @@ TEST(Report, ComparisonsAloneMakeAReportAndNothingIsAnError) {
     const json comparison = {{"scene", "cornell"}, {"views", "mono"}, {"width", 4}, {"height", 4},
                              {"reference_spp", 16}, {"frames", 1},     {"threads", 2},
                              {"techniques", json::array({{{"technique", "path"}, {"frame_ms", 2.5}, {"relmse", 0.1},
-                                                          {"ssim", 0.9}, {"flip", 0.05}}})}};
+                                                          {"ssim", 0.9}, {"flip", 0.05}},
+                                                         {{"technique", "vct"}, {"frame_ms", 1618.7}, {"relmse", 0.116},
+                                                          {"ssim", 0.7}, {"flip", 0.385}}})}};
     write_json(root / "compare" / "cornell" / "results.json", comparison);
     write_json(root / "compare" / ".cornell.partial" / "results.json", comparison);
     EXPECT_EQ(gilab::write_html_report(root), 0);
@@ -563,6 +565,7 @@ TEST(Report, ComparisonsAloneMakeAReportAndNothingIsAnError) {
     // What `gilab report` prints at the end of the main job: a line per technique.
     const std::string summary = gilab::comparison_summary(root);
     EXPECT_TRUE(contains(summary, "\n  path  cornell 2.5 ms, relMSE 0.1, FLIP 0.05\n")) << summary;
+    EXPECT_TRUE(contains(summary, "\n  vct   cornell 1619 ms, relMSE 0.116, FLIP 0.385\n")) << summary;
     EXPECT_FALSE(contains(summary, "partial")) << summary;
     EXPECT_EQ(gilab::comparison_summary(root / "nothing_here"), "");
     // The images were never written: named, not linked.
