@@ -23,6 +23,35 @@ void register_catalogue_bindings(py::module_& m) {
         },
         "The registered techniques as dicts (name, description), as `gilab list techniques`.");
     m.def(
+        "settings",
+        [](const std::string& technique) {
+            const TechniqueRegistry& registry = TechniqueRegistry::builtin();
+            const TechniqueInfo* info = registry.find(technique);
+            if (!info) registry.create(technique);  // throws gilab.Error listing the known ones
+            py::list list;
+            for (const SettingSpec& s : info->settings_schema().specs()) {
+                py::dict d("key"_a = s.key, "type"_a = to_string(s.type), "range"_a = s.range_text(), "unit"_a = s.unit,
+                           "description"_a = s.description, "quality_knob"_a = s.knob.has_value());
+                if (s.default_value.is_null())
+                    d["default"] = py::none(), d["derived_default"] = s.derived_default;
+                else if (s.default_value.is_boolean())
+                    d["default"] = s.default_value.get<bool>();
+                else if (s.default_value.is_number_integer())
+                    d["default"] = s.default_value.get<int64_t>();
+                else if (s.default_value.is_number())
+                    d["default"] = s.default_value.get<double>();
+                else
+                    d["default"] = s.default_value.get<std::string>();
+                if (s.type == SettingType::Choice) d["choices"] = s.choices;
+                list.append(d);
+            }
+            return list;
+        },
+        "technique"_a,
+        "A technique's settings as dicts (key, type, default, range, unit, description, quality_knob; choices for a "
+        "choice; derived_default when the default depends on the scene or other settings), as `gilab list settings "
+        "TECHNIQUE`.");
+    m.def(
         "scenes",
         [] {
             py::dict scenes;

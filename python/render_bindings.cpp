@@ -14,6 +14,7 @@
 #include "python/array_helpers.hpp"
 #include "python/bindings.hpp"
 #include "python/loaded_scene.hpp"
+#include "techniques/technique.hpp"
 
 namespace gilab::python {
 
@@ -98,6 +99,35 @@ std::shared_ptr<Film> mono_film(const RenderOutcome& r) {
 
 }  // namespace
 
+// render's help: the arguments, then every technique's settings table, from the
+// techniques' schemas (help(gilab.render) shows what `gilab list settings` prints).
+const std::string& render_doc() {
+    static const std::string doc = [] {
+        std::string text = R"doc(Renders a scene with one technique, exactly as ``gilab render`` does.
+
+scene       a gilab.Scene (gilab.load_scene)
+technique   "path", "photon", "vct", … (gilab.techniques())
+camera      None: the scene camera (mono) or, with `hmd`, the scene's head pose;
+            a gilab.Camera: a mono view; a gilab.HmdRig: a stereo pair
+hmd         headset preset name for a stereo pair (like --hmd)
+width, height   image (per-eye) size; default 512×512 mono, the preset's in stereo
+spp         samples per pixel (the setting "spp"; gilab.Error if the technique takes none)
+seed        random seed (same seed and settings ⇒ same image)
+settings    technique settings as a dict, e.g. {"photons": 16384, "radius": 0.03};
+            unknown keys raise gilab.Error
+time        scene time in seconds (animated scenes)
+ipd, time_budget, settings_file   as --ipd, --time-budget, --settings
+threads     worker threads (0 = all cores); images do not depend on it
+
+Returns a gilab.RenderResult. The GIL is released while rendering.
+)doc";
+        text += "\nTechnique settings (the `settings` dict; gilab.settings(name) gives them as dicts):\n";
+        for (const auto& t : TechniqueRegistry::builtin().list()) text.append("\n").append(t.settings_schema().table_text());
+        return text;
+    }();
+    return doc;
+}
+
 void register_render_bindings(py::module_& m) {
     py::class_<RenderOutcome>(m, "RenderResult", R"doc(What gilab.render returns: one film per view ("mono", or "left" and "right"),
 the technique's statistics and the effective settings.
@@ -168,24 +198,7 @@ float32 views into the films (no copy).
         "scene"_a, "technique"_a = "path", "camera"_a = py::none(), "hmd"_a = py::none(), "width"_a = py::none(),
         "height"_a = py::none(), "spp"_a = py::none(), "seed"_a = 1, "settings"_a = py::none(), "time"_a = 0.0,
         "ipd"_a = py::none(), "time_budget"_a = py::none(), "settings_file"_a = py::none(), "threads"_a = 0,
-        R"doc(Renders a scene with one technique, exactly as ``gilab render`` does.
-
-scene       a gilab.Scene (gilab.load_scene)
-technique   "path", "photon", "vct", … (gilab.techniques())
-camera      None: the scene camera (mono) or, with `hmd`, the scene's head pose;
-            a gilab.Camera: a mono view; a gilab.HmdRig: a stereo pair
-hmd         headset preset name for a stereo pair (like --hmd)
-width, height   image (per-eye) size; default 512×512 mono, the preset's in stereo
-spp         samples per pixel (the setting "spp"; gilab.Error if the technique takes none)
-seed        random seed (same seed and settings ⇒ same image)
-settings    technique settings as a dict, e.g. {"photons": 16384, "radius": 0.03};
-            unknown keys raise gilab.Error
-time        scene time in seconds (animated scenes)
-ipd, time_budget, settings_file   as --ipd, --time-budget, --settings
-threads     worker threads (0 = all cores); images do not depend on it
-
-Returns a gilab.RenderResult. The GIL is released while rendering.
-)doc");
+        render_doc().c_str());
 }
 
 }  // namespace gilab::python

@@ -12,6 +12,7 @@ namespace gilab {
 void TechniqueRegistry::add(TechniqueInfo info) {
     if (info.name.empty()) throw Error("technique registry", "a technique needs a name");
     if (!info.create) throw Error("technique registry", "technique '" + info.name + "' has no factory");
+    if (!info.settings_schema) throw Error("technique registry", "technique '" + info.name + "' has no settings schema");
     if (find(info.name)) throw Error("technique registry", "technique '" + info.name + "' is registered twice");
     techniques_.push_back(std::move(info));
 }

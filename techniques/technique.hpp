@@ -9,6 +9,7 @@
 #include "core/image/film.hpp"
 #include "core/scene/scene.hpp"
 #include "core/util/settings.hpp"
+#include "core/util/settings_schema.hpp"
 #include "core/util/stats.hpp"
 
 namespace gilab {
@@ -43,6 +44,9 @@ struct TechniqueInfo {
     std::string name;
     std::string description;
     std::function<std::unique_ptr<Technique>()> create;
+    // Every setting the technique reads: key, type, default, range, description and the
+    // quality knob of equal-time comparisons (`gilab list settings NAME` prints it).
+    std::function<const SettingsSchema&()> settings_schema;
 };
 
 class TechniqueRegistry {

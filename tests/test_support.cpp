@@ -1,5 +1,7 @@
 #include "tests/test_support.hpp"
+#include <cctype>
 #include <fstream>
+#include <gtest/gtest.h>
 #include "core/io/asset_paths.hpp"
 #include "core/util/error.hpp"
 
@@ -10,7 +12,16 @@ std::optional<std::filesystem::path> shared_asset(const std::string& relative) {
 }
 
 std::filesystem::path temp_dir(const std::string& name) {
-    auto dir = std::filesystem::path(GILAB_TEST_BINARY_DIR) / "test_output" / name;
+    // CTest runs every test case as a process of its own, two at once: cases that ask for
+    // the same name (the variants of a parameterised test) get a folder each, or one would
+    // remove the other's files while it reads them.
+    std::string test_case;
+    if (const auto* info = ::testing::UnitTest::GetInstance()->current_test_info()) {
+        test_case = std::string(info->test_suite_name()) + "." + info->name();
+        for (char& c : test_case)
+            if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-') c = '_';
+    }
+    auto dir = std::filesystem::path(GILAB_TEST_BINARY_DIR) / "test_output" / name / test_case;
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     return dir;

@@ -24,22 +24,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Knob {
-    const char* technique;
-    const char* setting;
-    double fallback;  // the technique's default
-    double low, high;
-};
-constexpr Knob kKnobs[] = {
-    {"path", "spp", 16, 1, 1 << 20},
-    {"photon", "photons", 256 * 256, 1024, 1 << 26},
-    {"vct", "diffuse_cones", 16, 1, 256},
-};
-
-const Knob* find_knob(const std::string& technique) {
-    for (const Knob& k : kKnobs)
-        if (technique == k.technique) return &k;
-    return nullptr;
+// The technique's quality knob, from its settings schema; null when it has none.
+const SettingSpec* find_knob(const std::string& technique) {
+    const TechniqueInfo* info = TechniqueRegistry::builtin().find(technique);
+    return info ? info->settings_schema().quality_knob() : nullptr;
 }
 
 void check_request(const CompareRequest& r) {
@@ -110,15 +98,16 @@ Run run_technique(const std::string& technique, const Scene& scene, const ViewSe
 // one frame, or the frame alone) is within 10 % of `budget_ms`; at most five tries. The
 // first step assumes time in proportion to the knob; later ones fit time = a + b · knob
 // through the last two tries, since prepare holds a part (the BVH) that does not scale.
-double tune_knob(const Knob& knob, const std::string& technique, const Scene& scene, const ViewSet& views,
+double tune_knob(const SettingSpec& knob, const std::string& technique, const Scene& scene, const ViewSet& views,
                  Settings settings, double budget_ms, EqualTimeOf of, std::ostream& log) {
-    double value = settings.has(knob.setting) ? settings.get<double>(knob.setting, knob.fallback) : knob.fallback;
+    const double fallback = knob.default_value.get<double>();
+    double value = settings.has(knob.key) ? settings.get<double>(knob.key, fallback) : fallback;
     double last_value = 0, last_ms = 0;
     for (int attempt = 0; attempt < 5; ++attempt) {
-        settings.set(knob.setting, int64_t(value));
+        settings.set(knob.key, int64_t(value));
         const Run run = run_technique(technique, scene, views, settings, 1);
         const double ms = run.timed_ms(of);
-        log << "  " << technique << ": " << knob.setting << "=" << int64_t(value) << " → " << ms << " ms ("
+        log << "  " << technique << ": " << knob.key << "=" << int64_t(value) << " → " << ms << " ms ("
             << to_string(of) << ")" << std::endl;
         if (std::abs(ms - budget_ms) < 0.1 * budget_ms) break;
         double next = value * budget_ms / std::max(ms, 1e-3);
@@ -126,7 +115,7 @@ double tune_knob(const Knob& knob, const std::string& technique, const Scene& sc
             const double slope = (ms - last_ms) / (value - last_value);
             if (slope > 0) next = value + (budget_ms - ms) / slope;
         }
-        next = std::clamp(std::round(next), knob.low, knob.high);
+        next = std::clamp(std::round(next), knob.knob->low, knob.knob->high);
         if (next == value) break;
         last_value = value, last_ms = ms;
         value = next;
@@ -170,8 +159,8 @@ EqualTimeOf parse_equal_time_of(const std::string& text) {
 }
 
 std::string quality_knob(const std::string& technique) {
-    const Knob* k = find_knob(technique);
-    return k ? k->setting : "";
+    const SettingSpec* k = find_knob(technique);
+    return k ? k->key : "";
 }
 
 std::string run_compare(const CompareRequest& request) {
@@ -245,12 +234,12 @@ std::string run_compare(const CompareRequest& request) {
         CompareEntry entry;
         entry.technique = technique;
         if (request.equal_time_seconds) {
-            if (const Knob* knob = find_knob(technique)) {
+            if (const SettingSpec* knob = find_knob(technique)) {
                 const double value = tune_knob(*knob, technique, scene, views, settings, *request.equal_time_seconds * 1000.0,
                                                request.equal_time_of, std::cout);
                 settings = settings_for(request, technique);
-                settings.set(knob->setting, int64_t(value));
-                entry.knob = std::string(knob->setting) + "=" + std::to_string(int64_t(value));
+                settings.set(knob->key, int64_t(value));
+                entry.knob = knob->key + "=" + std::to_string(int64_t(value));
             } else {
                 entry.knob = "no quality knob: its settings as given";
             }

@@ -20,6 +20,19 @@ using namespace gilab;
 
 namespace {
 
+// `gilab list settings [TECHNIQUE] [--markdown]`: each technique's settings schema.
+void print_settings(const std::string& technique, bool markdown) {
+    const TechniqueRegistry& registry = TechniqueRegistry::builtin();
+    if (!technique.empty() && !registry.find(technique)) registry.create(technique);  // throws listing the known ones
+    bool first = true;
+    for (const auto& t : registry.list()) {
+        if (!technique.empty() && t.name != technique) continue;
+        const SettingsSchema& schema = t.settings_schema();
+        std::cout << (first ? "" : "\n") << (markdown ? schema.table_markdown() : schema.table_text());
+        first = false;
+    }
+}
+
 void print_list(const std::string& what) {
     bool all = what.empty();
     if (all || what == "techniques") {
@@ -121,10 +134,15 @@ int main(int argc, char** argv) {
     auto* info = app.add_subcommand("info", "describe a scene: triangles, materials, lights, bounds, animation, closed meshes");
     info->add_option("scene", info_scene, "scene name or path")->required();
 
-    std::string list_what;
-    auto* list = app.add_subcommand("list", "list techniques, experiments, scenes and HMD presets");
-    list->add_option("what", list_what, "one of techniques, experiments, scenes, hmds")
-        ->check(CLI::IsMember({"techniques", "experiments", "scenes", "hmds"}));
+    std::string list_what, list_technique;
+    bool list_markdown = false;
+    auto* list = app.add_subcommand("list", "list techniques, experiments, scenes, HMD presets, or a technique's settings");
+    list->add_option("what", list_what, "one of techniques, experiments, scenes, hmds, settings")
+        ->check(CLI::IsMember({"techniques", "experiments", "scenes", "hmds", "settings"}));
+    list->add_option("technique", list_technique,
+                     "with `settings`: the technique whose settings to list (key, type, default, range, description); "
+                     "all techniques when left out");
+    list->add_flag("--markdown", list_markdown, "with `settings`: print Markdown tables (the README's settings tables)");
 
     std::vector<std::string> experiment_names;
     bool quick = false;
@@ -190,7 +208,12 @@ int main(int argc, char** argv) {
         } else if (*info) {
             std::cout << describe_scene(info_scene, assets);
         } else if (*list) {
-            print_list(list_what);
+            if (list_what != "settings" && (!list_technique.empty() || list_markdown))
+                throw Error("list", "a technique name and --markdown go with `gilab list settings` only");
+            if (list_what == "settings")
+                print_settings(list_technique, list_markdown);
+            else
+                print_list(list_what);
         } else if (*compare) {
             compare_request.techniques.clear();
             std::stringstream list(compare_techniques);

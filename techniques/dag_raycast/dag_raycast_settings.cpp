@@ -8,19 +8,11 @@
 namespace gilab {
 namespace {
 
-std::string key(const char* name) { return std::string("dag_raycast.") + name; }
-
-DagBuildMode parse_build(const std::string& s) {
-    if (s == "incremental") return DagBuildMode::Incremental;
-    if (s == "all_at_once") return DagBuildMode::AllAtOnce;
-    throw Error(key("build"), "unknown value '" + s + "' (incremental, all_at_once)");
-}
-
 DagShadowSource parse_shadows(const std::string& s) {
     for (DagShadowSource v : {DagShadowSource::Auto, DagShadowSource::ShadowDag, DagShadowSource::DagRay,
                               DagShadowSource::None})
         if (s == to_string(v)) return v;
-    throw Error(key("shadows"), "unknown value '" + s + "' (auto, shadow_dag, dag_ray, none)");
+    throw std::logic_error("dag_raycast: shadows '" + s + "' is declared but not handled");
 }
 
 }  // namespace
@@ -39,42 +31,53 @@ const char* to_string(DagShadowSource source) {
     return "?";
 }
 
+const SettingsSchema& DagRaycastSettings::schema() {
+    static const SettingsSchema schema = [] {
+        const DagRaycastSettings d;
+        SettingsSchema s("dag_raycast", "ray casting through a time-correlated multi-frame DAG (P2 §4)");
+        s.integer("resolution", d.resolution).range(2, kMaxVoxelResolution).unit("voxels per axis")
+            .doc("One grid shared by all frames.");
+        s.integer("frames", d.frames).range(0, 100000)
+            .doc("Animation frames in the DAG; 0: the scene's frame count, at most " +
+                 std::to_string(kDefaultMaxFrames) + ".");
+        s.number("fps", d.fps).at_least(0).unit("frames per second")
+            .doc("Frame k shows the scene at k / fps; 0: the scene's frame rate.");
+        s.choice("build", to_string(d.build), {"incremental", "all_at_once"})
+            .doc("incremental: frame n merged into frames 1..n−1, streamed cell by cell (P2 §4 (b)) | all_at_once: "
+                 "per-frame DAGs merged together (P2 §4 (a)).");
+        s.integer("light", d.light).at_least(-1)
+            .doc("Index of the light; -1: the scene's first point, spot or directional light (none: a headlight).");
+        s.number("ambient", d.ambient).range(0, 1).unit("of the light's irradiance").doc("Unshadowed ambient light.");
+        s.choice("shadows", to_string(d.shadows), {"auto", "shadow_dag", "dag_ray", "none"})
+            .doc("auto = shadow_dag: the frame's shadow DAGs (P2 §3), one over a directional or spot light's light "
+                 "space, a cube of six for a point light | dag_ray: a shadow ray through the frame's DAG | none.");
+        s.integer("shadow_resolution", d.shadow_resolution).range(0, 131072).unit("voxels per axis")
+            .doc("Resolution of each frame's shadow DAG, 8 or more; 0: the voxel resolution.");
+        s.integer("tile_size", d.tile_size).range(1, 1024).unit("pixels").doc("Square screen tile of one parallel task.");
+        s.integer("seed", int64_t(d.seed)).at_least(0).doc("Recorded only: nothing in this technique is random.");
+        s.integer("spp", 1).range(1, 1).unit("samples per pixel").doc("One primary ray per pixel through the frame's root.");
+        return s;
+    }();
+    return schema;
+}
+
 DagRaycastSettings DagRaycastSettings::from(const Settings& s) {
+    const SettingsSchema& schema = DagRaycastSettings::schema();
     DagRaycastSettings o;
-    const int64_t resolution = s.get<int64_t>("resolution", o.resolution);
-    if (resolution < 2 || resolution > int64_t(kMaxVoxelResolution))
-        throw Error(key("resolution"),
-                    "must be in 2.." + std::to_string(kMaxVoxelResolution) + ", not " + std::to_string(resolution));
-    o.resolution = uint32_t(resolution);
-    const int64_t frames = s.get<int64_t>("frames", o.frames);
-    if (frames < 0 || frames > 100000)
-        throw Error(key("frames"), "must be 0 (the scene's, at most 100) or 1..100000, not " + std::to_string(frames));
-    o.frames = int(frames);
-    o.fps = s.get<double>("fps", o.fps);
-    if (!(o.fps >= 0) || !std::isfinite(o.fps))
-        throw Error(key("fps"), "must be 0 (the scene's) or a positive frame rate, not " + std::to_string(o.fps));
-    o.build = parse_build(s.get<std::string>("build", to_string(o.build)));
-    o.light = s.get<int>("light", o.light);
-    if (o.light < -1) throw Error(key("light"), "must be -1 (automatic) or a light index");
-    o.ambient = s.get<float>("ambient", o.ambient);
-    if (!(o.ambient >= 0 && o.ambient <= 1)) throw Error(key("ambient"), "must be in [0, 1]");
-    o.shadows = parse_shadows(s.get<std::string>("shadows", to_string(o.shadows)));
-    const int64_t shadow_resolution = s.get<int64_t>("shadow_resolution", o.shadow_resolution);
-    if (shadow_resolution != 0 && (shadow_resolution < 8 || shadow_resolution > 131072))
-        throw Error(key("shadow_resolution"),
-                    "must be 0 (the voxel resolution) or in 8..131072, not " + std::to_string(shadow_resolution));
-    o.shadow_resolution = uint32_t(shadow_resolution);
-    o.tile_size = s.get<int>("tile_size", o.tile_size);
-    if (o.tile_size < 1 || o.tile_size > 1024) throw Error(key("tile_size"), "must be in 1..1024");
-    // Nothing here is random; the seed every render passes is read so it is not an
-    // unknown setting, and recorded in the output.
-    const int64_t seed = s.get<int64_t>("seed", int64_t(o.seed));
-    if (seed < 0) throw Error(key("seed"), "must be non-negative");
-    o.seed = uint64_t(seed);
-    const int spp = s.get<int>("spp", 1);
-    if (spp != 1)
-        throw Error(key("spp"), "the ray caster traces one primary ray per pixel; spp must be 1, not " +
-                                    std::to_string(spp));
+    o.resolution = schema.get<uint32_t>(s, "resolution");
+    o.frames = schema.get<int>(s, "frames");
+    o.fps = schema.get<double>(s, "fps");
+    o.build = schema.get<std::string>(s, "build") == "all_at_once" ? DagBuildMode::AllAtOnce : DagBuildMode::Incremental;
+    o.light = schema.get<int>(s, "light");
+    o.ambient = schema.get<float>(s, "ambient");
+    o.shadows = parse_shadows(schema.get<std::string>(s, "shadows"));
+    o.shadow_resolution = schema.get<uint32_t>(s, "shadow_resolution");
+    if (o.shadow_resolution != 0 && o.shadow_resolution < 8)
+        throw Error(s.context(), "setting 'shadow_resolution' must be 0 (the voxel resolution) or 8 to 131072, got " +
+                                     std::to_string(o.shadow_resolution));
+    o.tile_size = schema.get<int>(s, "tile_size");
+    o.seed = uint64_t(schema.get<int64_t>(s, "seed"));
+    (void)schema.get<int>(s, "spp");  // checked: only 1
     return o;
 }
 

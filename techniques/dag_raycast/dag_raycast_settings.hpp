@@ -1,19 +1,9 @@
 #pragma once
-// Settings of the dag_raycast technique, read from a Settings dictionary. Every key is
-// checked; keys it does not read are reported by the caller.
-//
-// resolution (256: voxels per axis of the one grid shared by all frames), frames (0: the
-// scene's animation frame count, capped at 100), fps (0: the scene's frame rate; frame k
-// shows the scene at k / fps), build (incremental | all_at_once: how the frames are merged,
-// P2 §4 (b) / (a)), light (-1: the scene's first point or directional light, else its
-// index), ambient (0.05: unshadowed light as a fraction of the light's irradiance),
-// shadows (auto = shadow_dag | dag_ray | none: shadow_dag looks up the frame's shadow
-// DAGs, one over a directional or spot light's light space or a cube of six for a point
-// light; dag_ray casts a shadow ray through the frame's DAG), shadow_resolution (0: the voxel resolution; voxels per
-// axis of each frame's shadow DAG), tile_size (16: image tile), seed (recorded only: nothing is random), spp (only 1: one
-// primary ray per pixel).
+// Settings of the dag_raycast technique: DagRaycastSettings::schema() declares every key
+// with its default, range and description (`gilab list settings dag_raycast`).
 #include <cstdint>
 #include "core/util/settings.hpp"
+#include "core/util/settings_schema.hpp"
 
 namespace gilab {
 
@@ -42,7 +32,9 @@ struct DagRaycastSettings {
     uint64_t seed = 1;
 
     static constexpr int kDefaultMaxFrames = 100;
-    // Throws Error naming the key ("dag_raycast.<key>") for a bad value.
+    // Every key with its default (the members above), range and description.
+    static const SettingsSchema& schema();
+    // Throws Error naming the key for a bad value.
     static DagRaycastSettings from(const Settings& settings);
 };
 

@@ -251,7 +251,7 @@ void register_dag_raycast(TechniqueRegistry& registry) {
                   "ray casting through a time-correlated multi-frame DAG: one root per animation frame, voxel "
                   "face normals, one light; shadows from each frame's shadow DAGs (a cube of six for a point "
                   "light) or shadow rays through the same frame",
-                  [] { return std::make_unique<DagRaycastTechnique>(); }});
+                  [] { return std::make_unique<DagRaycastTechnique>(); }, &DagRaycastSettings::schema});
 }
 
 }  // namespace gilab

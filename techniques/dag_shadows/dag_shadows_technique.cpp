@@ -16,8 +16,7 @@ VisibilitySource parse_visibility(const std::string& s) {
     if (s == "shadow_map") return VisibilitySource::ShadowMap;
     if (s == "shadow_dag") return VisibilitySource::ShadowDag;
     if (s == "shadow_dag_double_depth") return VisibilitySource::ShadowDagDoubleDepth;
-    throw Error(std::string(kName) + ".visibility",
-                "unknown value '" + s + "' (ray, shadow_map, shadow_dag, shadow_dag_double_depth)");
+    throw std::logic_error("dag_shadows: visibility '" + s + "' is declared but not handled");
 }
 
 // Irradiance from the light on a surface facing it head-on, at p (unoccluded).
@@ -47,37 +46,51 @@ const char* to_string(VisibilitySource source) {
     return "?";
 }
 
+const SettingsSchema& DagShadowsSettings::schema() {
+    static const SettingsSchema schema = [] {
+        const DagShadowsSettings d;
+        SettingsSchema s(kName, "direct light with visibility from a chosen structure (P2 §3)");
+        s.choice("visibility", to_string(d.visibility), {"shadow_dag", "shadow_dag_double_depth", "shadow_map", "ray"})
+            .doc("shadow_dag: P2's shadow DAG (S2) | shadow_dag_double_depth: over double depth maps (S3) | "
+                 "shadow_map: a plain shadow map at the same x–y resolution (S1) | ray: Embree shadow rays.");
+        s.integer("resolution", d.resolution).range(8, kMaxLightSpaceResolution).unit("light-space voxels per axis")
+            .doc("Resolution of the light space (and of the shadow map's x–y).");
+        s.integer("light", d.light).at_least(-1)
+            .doc("Index of the shadow light among the scene's punctual lights; -1: the first directional or spot "
+                 "light (point lights are refused).");
+        s.integer("pcf", d.pcf).range(1, 9).unit("k for a k×k filter").doc("Percentage-closer filtering.");
+        s.integer("shadow_map_bits", d.shadow_map_bits).range(16, 32).doc("Depth precision of the shadow map: 16 or 32.");
+        s.integer("tile", d.tile).range(0, kMaxLightSpaceResolution).unit("voxels, a power of two")
+            .doc("x–y tile side of the DAG build; 0: automatic.");
+        s.choice("undefined_as", "shadow", {"shadow", "lit"})
+            .doc("How undefined space inside boundary nodes is stored, and what lookups there answer.");
+        s.number("ambient", d.ambient).range(0, 1).unit("of the light's irradiance")
+            .doc("Unshadowed ambient light, so shadowed surfaces stay visible.");
+        s.integer("tile_size", d.tile_size).range(1, 1024).unit("pixels").doc("Square screen tile of one parallel task.");
+        s.integer("seed", int64_t(d.seed)).at_least(0).doc("Recorded only: nothing in this technique is random.");
+        return s;
+    }();
+    return schema;
+}
+
 DagShadowsSettings DagShadowsSettings::from(const Settings& s) {
+    const SettingsSchema& schema = DagShadowsSettings::schema();
+    const std::string& where = s.context();
     DagShadowsSettings o;
-    o.visibility = parse_visibility(s.get<std::string>("visibility", to_string(o.visibility)));
-    const int64_t res = s.get<int64_t>("resolution", o.resolution);
-    if (res < 8 || res > int64_t(kMaxLightSpaceResolution))
-        throw Error(std::string(kName) + ".resolution",
-                    "must be in 8.." + std::to_string(kMaxLightSpaceResolution) + ", not " + std::to_string(res));
-    o.resolution = uint32_t(res);
-    o.light = s.get<int>("light", o.light);
-    o.pcf = s.get<int>("pcf", o.pcf);
-    if (o.pcf < 1 || o.pcf > 9) throw Error(std::string(kName) + ".pcf", "must be in 1..9");
-    o.shadow_map_bits = s.get<int>("shadow_map_bits", o.shadow_map_bits);
+    o.visibility = parse_visibility(schema.get<std::string>(s, "visibility"));
+    o.resolution = schema.get<uint32_t>(s, "resolution");
+    o.light = schema.get<int>(s, "light");
+    o.pcf = schema.get<int>(s, "pcf");
+    o.shadow_map_bits = schema.get<int>(s, "shadow_map_bits");
     if (o.shadow_map_bits != 16 && o.shadow_map_bits != 32)
-        throw Error(std::string(kName) + ".shadow_map_bits", "must be 16 or 32");
-    const int64_t tile = s.get<int64_t>("tile", 0);
-    if (tile < 0 || tile > int64_t(kMaxLightSpaceResolution) || (tile & (tile - 1)))
-        throw Error(std::string(kName) + ".tile", "must be 0 (automatic) or a power of two");
-    o.tile = uint32_t(tile);
-    const std::string undefined = s.get<std::string>("undefined_as", "shadow");
-    if (undefined != "lit" && undefined != "shadow")
-        throw Error(std::string(kName) + ".undefined_as", "must be lit or shadow, not '" + undefined + "'");
-    o.undefined_as = undefined == "lit" ? ShadowState::Lit : ShadowState::Shadow;
-    o.ambient = s.get<float>("ambient", o.ambient);
-    if (!(o.ambient >= 0 && o.ambient <= 1)) throw Error(std::string(kName) + ".ambient", "must be in [0, 1]");
-    o.tile_size = s.get<int>("tile_size", o.tile_size);
-    // Nothing here is random; the seed every render passes is read so it is not an
-    // unknown setting, and recorded in the output.
-    const int64_t seed = s.get<int64_t>("seed", 1);
-    if (seed < 0) throw Error(std::string(kName) + ".seed", "must be non-negative");
-    o.seed = uint64_t(seed);
-    if (o.tile_size < 1 || o.tile_size > 1024) throw Error(std::string(kName) + ".tile_size", "must be in 1..1024");
+        throw Error(where, "setting 'shadow_map_bits' must be 16 or 32, got " + std::to_string(o.shadow_map_bits));
+    o.tile = schema.get<uint32_t>(s, "tile");
+    if (o.tile & (o.tile - 1))
+        throw Error(where, "setting 'tile' must be 0 (automatic) or a power of two, got " + std::to_string(o.tile));
+    o.undefined_as = schema.get<std::string>(s, "undefined_as") == "lit" ? ShadowState::Lit : ShadowState::Shadow;
+    o.ambient = schema.get<float>(s, "ambient");
+    o.tile_size = schema.get<int>(s, "tile_size");
+    o.seed = uint64_t(schema.get<int64_t>(s, "seed"));
     return o;
 }
 
@@ -259,7 +272,7 @@ void register_dag_shadows(TechniqueRegistry& registry) {
     registry.add({kName,
                   "direct light with visibility from shadow rays, a shadow map, or the shadow DAG (with or "
                   "without double depth maps)",
-                  [] { return std::make_unique<DagShadowsTechnique>(); }});
+                  [] { return std::make_unique<DagShadowsTechnique>(); }, &DagShadowsSettings::schema});
 }
 
 }  // namespace gilab

@@ -5,14 +5,7 @@
 // frame traces primary hits, then asks the structure for the visibility of all hit
 // points in one batch (timed on its own as the frame's shadow time), then shades.
 //
-// Settings: visibility (shadow_dag | shadow_dag_double_depth | shadow_map | ray),
-// resolution (1024: light-space voxels per axis), light (index of the shadow light
-// among the scene's punctual lights; default the first directional or spot light),
-// pcf (1: k×k percentage-closer filtering), shadow_map_bits (32 or 16), tile (0: the
-// DAG build's x–y tile side, 0 = automatic), undefined_as (shadow: how undefined space
-// left inside boundary nodes is stored and what lookups there answer, shadow or lit), ambient (0.03: unshadowed ambient
-// irradiance as a fraction of the light's, so shadowed surfaces stay visible),
-// tile_size (16: image tile), seed (recorded only: nothing is random).
+// Settings: DagShadowsSettings::schema() (`gilab list settings dag_shadows`).
 // Layers: color (emission + diffuse reflection of the light and the ambient term),
 // visibility (1 channel, the answer of the structure; 0 for background and for surfaces
 // turned away from the light, which are not looked up).
@@ -39,6 +32,8 @@ struct DagShadowsSettings {
     float ambient = 0.03f;
     int tile_size = 16;
     uint64_t seed = 1;  // accepted and recorded; the technique draws no random numbers
+    // Every key with its default (the members above), range and description.
+    static const SettingsSchema& schema();
     static DagShadowsSettings from(const Settings& settings);
 };
 

@@ -31,21 +31,34 @@ void add_light(PathSample& s, int bounces, const Vec3& value) {
 
 }  // namespace
 
+const SettingsSchema& PathTracerSettings::schema() {
+    static const SettingsSchema schema = [] {
+        const PathTracerSettings d;
+        SettingsSchema s("path", "reference path tracer (next-event estimation + MIS, Russian roulette)");
+        s.integer("spp", d.spp).at_least(1).unit("samples per pixel")
+            .doc("Camera samples per pixel; every layer is their mean.")
+            .quality_knob(1, 1 << 20);
+        s.integer("seed", int64_t(d.seed)).at_least(0).doc("Seed of every random stream (same seed, same image).");
+        s.integer("max_depth", d.max_depth).at_least(0).unit("bounces")
+            .doc("Longest path: scattering events before a path ends.");
+        s.integer("rr_depth", d.rr_depth).at_least(0).unit("bounces")
+            .doc("Russian roulette starts once a path has this many bounces.");
+        s.integer("tile_size", d.tile_size).at_least(1).unit("pixels").doc("Square screen tile of one parallel task.");
+        s.boolean("jitter", d.jitter).doc("true: sample positions uniform in the pixel; false: pixel centres.");
+        return s;
+    }();
+    return schema;
+}
+
 PathTracerSettings PathTracerSettings::from(const Settings& s) {
+    const SettingsSchema& schema = PathTracerSettings::schema();
     PathTracerSettings p;
-    const std::string& where = s.context();
-    p.spp = s.get<int>("spp", p.spp);
-    int64_t seed = s.get<int64_t>("seed", int64_t(p.seed));
-    p.max_depth = s.get<int>("max_depth", p.max_depth);
-    p.rr_depth = s.get<int>("rr_depth", p.rr_depth);
-    p.tile_size = s.get<int>("tile_size", p.tile_size);
-    p.jitter = s.get<bool>("jitter", p.jitter);
-    if (p.spp < 1) throw Error(where, "setting 'spp' must be at least 1, got " + std::to_string(p.spp));
-    if (seed < 0) throw Error(where, "setting 'seed' must not be negative, got " + std::to_string(seed));
-    if (p.max_depth < 0) throw Error(where, "setting 'max_depth' must not be negative, got " + std::to_string(p.max_depth));
-    if (p.rr_depth < 0) throw Error(where, "setting 'rr_depth' must not be negative, got " + std::to_string(p.rr_depth));
-    if (p.tile_size < 1) throw Error(where, "setting 'tile_size' must be at least 1, got " + std::to_string(p.tile_size));
-    p.seed = uint64_t(seed);
+    p.spp = schema.get<int>(s, "spp");
+    p.seed = uint64_t(schema.get<int64_t>(s, "seed"));
+    p.max_depth = schema.get<int>(s, "max_depth");
+    p.rr_depth = schema.get<int>(s, "rr_depth");
+    p.tile_size = schema.get<int>(s, "tile_size");
+    p.jitter = schema.get<bool>(s, "jitter");
     return p;
 }
 
@@ -241,7 +254,7 @@ void PathTracer::render(const ViewSet& views, std::vector<Film>& films) {
 void register_path_tracer(TechniqueRegistry& registry) {
     registry.add({"path",
                   "reference unidirectional path tracer (next-event estimation + MIS, Russian roulette)",
-                  [] { return std::make_unique<PathTracer>(); }});
+                  [] { return std::make_unique<PathTracer>(); }, &PathTracerSettings::schema});
 }
 
 }  // namespace gilab

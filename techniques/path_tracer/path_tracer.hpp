@@ -6,8 +6,7 @@
 // Every sample draws from Rng::for_sample(seed, pixel, sample, view), and each pixel is
 // accumulated by one task in sample order, so images are identical at any thread count.
 //
-// Settings: spp (16), seed (1), max_depth (8), rr_depth (3), tile_size (16),
-// jitter (true: sample positions jittered inside the pixel; false: pixel centres).
+// Settings: PathTracerSettings::schema() (`gilab list settings path`).
 // Layers: color, direct (emission seen directly + one-bounce lighting), indirect
 // (two or more bounces; color = direct + indirect), albedo (diffuse + specular
 // reflectance at the first hit), normal (world-space shading normal at the first hit),
@@ -28,8 +27,10 @@ struct PathTracerSettings {
     int tile_size = 16;
     bool jitter = true;
 
-    // Reads every key above from `settings` (with get, so the caller can report the
-    // rest) and checks the values; throws Error naming the bad key.
+    // Every key with its default (the members above), range and description.
+    static const SettingsSchema& schema();
+    // Reads every key of the schema from `settings` (with get, so the caller can report
+    // the rest) and checks the values; throws Error naming the bad key.
     static PathTracerSettings from(const Settings& settings);
 };
 

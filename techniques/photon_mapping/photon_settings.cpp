@@ -1,4 +1,5 @@
 #include <cmath>
+#include <optional>
 #include "core/util/error.hpp"
 #include "core/util/format.hpp"
 #include "core/util/memory_budget.hpp"
@@ -15,15 +16,7 @@ namespace {
 void check_progressive(const Settings& s, PhotonMappingSettings& p, const std::string& pass, const std::string& map,
                        const std::string& gather, const std::string& storage) {
     const std::string& where = s.context();
-    ProgressiveSettings& g = p.progressive;
-    if (g.iterations < 1)
-        throw Error(where, "setting 'iterations' must be at least 1, got " + std::to_string(g.iterations));
-    if (!(g.alpha > 0.0 && g.alpha < 1.0))
-        throw Error(where, "setting 'alpha' must be in (0, 1) (the fraction of new photons kept), got " +
-                               format_number(g.alpha));
-    if (g.time_budget && !(*g.time_budget > 0.0))
-        throw Error(where, "setting 'time_budget' must be a positive number of seconds, got " +
-                               format_number(*g.time_budget));
+    const ProgressiveSettings& g = p.progressive;
     if (!g.enabled) {
         for (const char* key : {"iterations", "alpha", "time_budget"})
             if (s.has(key))
@@ -57,48 +50,132 @@ void check_progressive(const Settings& s, PhotonMappingSettings& p, const std::s
 
 }  // namespace
 
+const SettingsSchema& PhotonMappingSettings::schema() {
+    static const SettingsSchema schema = [] {
+        const PhotonMappingSettings d;
+        SettingsSchema s("photon", "photon mapping (P1)");
+        s.integer("photons", int64_t(d.photons)).at_least(1).unit("emitted per frame")
+            .doc("Photons traced from the lights each frame (each pass in progressive mode).")
+            .quality_knob(1024, 1 << 26);
+        s.number("radius", d.radius).above(0).unit("scene units")
+            .derived("3 % of the scene's bounding-box diagonal (the stat `radius` gives the value used)")
+            .doc("Gather radius; in progressive mode every pixel's initial radius.");
+        s.choice("gather", "radius", {"radius", "knn"})
+            .doc("radius: every photon within the radius, no heap | knn: the k nearest, with a heap.");
+        s.integer("k", d.k).at_least(1).unit("photons").doc("Photons gathered with gather=knn.");
+        s.choice("photon_map", to_string(d.photon_map), {"hash_grid", "kd_tree", "nanoflann"})
+            .doc("The photon map's structure: P1's hash grid, Jensen's kd-tree or a nanoflann kd-tree.");
+        s.choice("hash_query", to_string(d.hash_query), {"runs9", "cells27"})
+            .doc("Hash-grid neighbourhood fetch: 9 runs of 3 cells, or 27 single cells.");
+        s.choice("photon_storage", to_string(d.storage), {"indirect", "every_hit"})
+            .doc("indirect: photons from their second hit on, direct light by shadow rays | every_hit: P1's map, a "
+                 "copy at every non-specular hit, direct light from the first-hit photons.");
+        s.choice("pass", "fused", {"fused", "split"})
+            .doc("fused: trace and gather per pixel in one loop | split: all primary hits into a buffer, then a "
+                 "gather pass (bit-identical).");
+        s.choice("gather_order", "cell", {"cell", "tiles"})
+            .derived("tiles with tile_shared=paper, else cell")
+            .doc("pass=split only: the gather pass walks hits sorted by hash cell, or share tiles in image order "
+                 "(the paper's hybrid kernel).");
+        s.choice("tile_shared", to_string(d.tile_shared), {"off", "paper", "cell_groups"})
+            .booleans_mean("cell_groups", "off")
+            .doc("Hash grid only, bit-identical. paper: P1's Algorithm 1, a share tile fetches its cell's "
+                 "neighbourhood once if all its hits lie in one cell | cell_groups: hits sharing a cell share one "
+                 "fetch. JSON true/false of older files mean cell_groups/off.");
+        s.integer("share_tile", d.share_tile).at_least(1).unit("pixels square")
+            .doc("The paper's thread-group tile (its size is not given); tile_size must be a multiple of it with "
+                 "tile_shared=paper.");
+        s.integer("seed", int64_t(d.seed)).at_least(0).doc("Seed of every random stream (same seed, same image).");
+        s.integer("light_samples", d.light_samples).range(0, 0xffff).unit("per hit")
+            .doc("Area-light samples per primary hit (each punctual light gets one exact shadow ray); leave out "
+                 "with photon_storage=every_hit.");
+        s.integer("max_photon_depth", d.max_photon_depth).at_least(1).unit("surface hits")
+            .doc("Longest photon path.");
+        s.integer("tile_size", d.tile_size).at_least(1).unit("pixels").doc("Square screen tile of one parallel task.");
+        s.integer("spp", d.sampling.spp).range(1, kMaxPhotonSpp).unit("samples per pixel")
+            .doc("Primary rays per pixel, each with its own light samples, all gathering from the frame's one map; "
+                 "every layer is their mean.");
+        s.boolean("jitter", false).derived("true when spp > 1")
+            .doc("true: sample positions uniform in the pixel | false: pixel centres.");
+        s.boolean("stereo_reuse", d.stereo.enabled)
+            .doc("Stereo: fill right-eye pixels from the left eye's hits (P1's reprojection).");
+        s.choice("stereo_match", to_string(d.stereo.match), {"nearest", "strict"})
+            .doc("nearest: the paper's claim | strict: only where the right pixel's own ray hits the same point.");
+        s.number("stereo_tolerance", d.stereo.tolerance).at_least(0).unit("pixel footprints")
+            .doc("stereo_match=strict: how far the two hits may lie apart.");
+        s.boolean("stereo_reshade", d.stereo.reshade)
+            .doc("true: re-evaluate the glossy lobe for the right eye | false: copy the left colour (the paper).");
+        s.boolean("stereo_fill", d.stereo.fill)
+            .doc("Fill one-pixel reprojection cracks from neighbouring claims (stereo_match=nearest only).");
+        s.boolean("foveated", d.foveation.enabled)
+            .doc("Gather at every pixel in the fovea, once per 2×2 block out to twice its angle, once per 4×4 "
+                 "block beyond.");
+        s.number("fovea_angle", d.foveation.fovea_degrees).above(0).below(180).unit("degrees")
+            .doc("Half-angle of the fovea around the gaze.");
+        s.integer("periphery_photon_stride", d.foveation.periphery_photon_stride).at_least(1)
+            .doc("The periphery gathers from every stride-th photon, its flux scaled up.");
+        s.number("gaze_yaw", d.foveation.gaze_yaw_degrees).range(-90, 90).unit("degrees")
+            .doc("Gaze turned right of the eye's forward axis.");
+        s.number("gaze_pitch", d.foveation.gaze_pitch_degrees).range(-90, 90).unit("degrees")
+            .doc("Gaze turned up from the eye's forward axis.");
+        s.boolean("progressive", d.progressive.enabled)
+            .doc("Stochastic progressive photon mapping (Hachisuka & Jensen 2009).");
+        s.integer("iterations", d.progressive.iterations).at_least(1)
+            .doc("Progressive: photon passes, each with one visible point per pixel.");
+        s.number("alpha", d.progressive.alpha).above(0).below(1)
+            .doc("Progressive: the fraction of new photons kept (the paper's α).");
+        s.number("time_budget", 0).above(0).unit("seconds").derived("none: all iterations")
+            .doc("Progressive: stop after the iteration that fills it (gilab render --time-budget sets it).");
+        return s;
+    }();
+    return schema;
+}
+
 PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
+    const SettingsSchema& schema = PhotonMappingSettings::schema();
     PhotonMappingSettings p;
     const std::string& where = s.context();
-    int64_t photons = s.get<int64_t>("photons", int64_t(p.photons));
-    p.radius = s.get<float>("radius", p.radius);
-    p.radius_from_scene = !s.has("radius");
-    std::string gather = s.get<std::string>("gather", "radius");
-    p.k = s.get<int>("k", p.k);
-    std::string map = s.get<std::string>("photon_map", to_string(p.photon_map));
-    std::string hash_query = s.get<std::string>("hash_query", to_string(p.hash_query));
-    std::string pass = s.get<std::string>("pass", "fused");
-    std::string storage = s.get<std::string>("photon_storage", to_string(p.storage));
-    p.tile_shared = parse_tile_share(s.get<nlohmann::json>("tile_shared", to_string(p.tile_shared)), where);
-    p.share_tile = s.get<int>("share_tile", p.share_tile);
-    const bool order_given = s.has("gather_order");
-    std::string order = s.get<std::string>("gather_order", p.tile_shared == TileShare::Paper ? "tiles" : "cell");
-    int64_t seed = s.get<int64_t>("seed", int64_t(p.seed));
-    p.light_samples = s.get<int>("light_samples", p.light_samples);
-    p.max_photon_depth = s.get<int>("max_photon_depth", p.max_photon_depth);
-    p.tile_size = s.get<int>("tile_size", p.tile_size);
-    p.sampling.spp = s.get<int>("spp", p.sampling.spp);
+    p.photons = uint64_t(schema.get<int64_t>(s, "photons"));
+    const std::optional<float> radius = schema.get_given<float>(s, "radius");
+    p.radius_from_scene = !radius;
+    if (radius) p.radius = *radius;
+    const std::string gather = schema.get<std::string>(s, "gather");
+    p.gather = gather == "knn" ? GatherMode::Knn : GatherMode::Radius;
+    p.k = schema.get<int>(s, "k");
+    const std::string map = schema.get<std::string>(s, "photon_map");
+    p.photon_map = parse_photon_map_kind(map, where + ": setting 'photon_map'");
+    p.hash_query = parse_hash_query(schema.get<std::string>(s, "hash_query"), where + ": setting 'hash_query'");
+    const std::string pass = schema.get<std::string>(s, "pass");
+    p.split = pass == "split";
+    const std::string storage = schema.get<std::string>(s, "photon_storage");
+    p.storage = storage == "every_hit" ? PhotonStorage::EveryHit : PhotonStorage::Indirect;
+    p.tile_shared = parse_tile_share(schema.get<std::string>(s, "tile_shared"), where);
+    p.share_tile = schema.get<int>(s, "share_tile");
+    const std::optional<std::string> order = schema.get_given<std::string>(s, "gather_order");
+    p.gather_by_tiles = order ? *order == "tiles" : p.tile_shared == TileShare::Paper;
+    p.seed = uint64_t(schema.get<int64_t>(s, "seed"));
+    p.light_samples = schema.get<int>(s, "light_samples");
+    p.max_photon_depth = schema.get<int>(s, "max_photon_depth");
+    p.tile_size = schema.get<int>(s, "tile_size");
+    p.sampling.spp = schema.get<int>(s, "spp");
     // Jittered by default only with several samples: one sample stays at the pixel centre,
     // the image of the one-ray-per-pixel technique.
-    p.sampling.jitter = s.get<bool>("jitter", p.sampling.spp > 1);
-    p.stereo.enabled = s.get<bool>("stereo_reuse", p.stereo.enabled);
-    std::string match = s.get<std::string>("stereo_match", to_string(p.stereo.match));
-    p.stereo.tolerance = s.get<float>("stereo_tolerance", p.stereo.tolerance);
-    p.stereo.reshade = s.get<bool>("stereo_reshade", p.stereo.reshade);
-    p.stereo.fill = s.get<bool>("stereo_fill", p.stereo.fill);
-    p.foveation.enabled = s.get<bool>("foveated", p.foveation.enabled);
-    p.foveation.fovea_degrees = s.get<float>("fovea_angle", p.foveation.fovea_degrees);
-    p.foveation.periphery_photon_stride = s.get<int>("periphery_photon_stride", p.foveation.periphery_photon_stride);
-    p.foveation.gaze_yaw_degrees = s.get<float>("gaze_yaw", p.foveation.gaze_yaw_degrees);
-    p.foveation.gaze_pitch_degrees = s.get<float>("gaze_pitch", p.foveation.gaze_pitch_degrees);
-    p.progressive.enabled = s.get<bool>("progressive", p.progressive.enabled);
-    p.progressive.iterations = s.get<int>("iterations", p.progressive.iterations);
-    p.progressive.alpha = s.get<double>("alpha", p.progressive.alpha);
-    const double time_budget = s.get<double>("time_budget", 0.0);
-    if (s.has("time_budget")) p.progressive.time_budget = time_budget;
+    p.sampling.jitter = schema.get_given<bool>(s, "jitter").value_or(p.sampling.spp > 1);
+    p.stereo.enabled = schema.get<bool>(s, "stereo_reuse");
+    p.stereo.match = schema.get<std::string>(s, "stereo_match") == "strict" ? StereoMatch::Strict : StereoMatch::Nearest;
+    p.stereo.tolerance = schema.get<float>(s, "stereo_tolerance");
+    p.stereo.reshade = schema.get<bool>(s, "stereo_reshade");
+    p.stereo.fill = schema.get<bool>(s, "stereo_fill");
+    p.foveation.enabled = schema.get<bool>(s, "foveated");
+    p.foveation.fovea_degrees = schema.get<float>(s, "fovea_angle");
+    p.foveation.periphery_photon_stride = schema.get<int>(s, "periphery_photon_stride");
+    p.foveation.gaze_yaw_degrees = schema.get<float>(s, "gaze_yaw");
+    p.foveation.gaze_pitch_degrees = schema.get<float>(s, "gaze_pitch");
+    p.progressive.enabled = schema.get<bool>(s, "progressive");
+    p.progressive.iterations = schema.get<int>(s, "iterations");
+    p.progressive.alpha = schema.get<double>(s, "alpha");
+    p.progressive.time_budget = schema.get_given<double>(s, "time_budget");
 
-    if (photons < 1) throw Error(where, "setting 'photons' must be at least 1, got " + std::to_string(photons));
-    p.photons = uint64_t(photons);
     // The least a map can hold is about one stored copy per emitted photon (a closed
     // scene stores at least that): its record and its structure-of-arrays copy. A count
     // that cannot fit is refused before any photon is traced.
@@ -107,79 +184,20 @@ PhotonMappingSettings PhotonMappingSettings::from(const Settings& s) {
                         "setting 'photons' = " + std::to_string(p.photons) + " (about " +
                             std::to_string(kBytesPerStoredPhoton) + " B per stored photon, one per emitted photon at least)",
                         where);
-    if (!(p.radius > 0.0f) || !std::isfinite(p.radius))
-        throw Error(where, "setting 'radius' must be positive and finite, got " + format_number(p.radius));
-    if (gather == "radius")
-        p.gather = GatherMode::Radius;
-    else if (gather == "knn")
-        p.gather = GatherMode::Knn;
-    else
-        throw Error(where, "setting 'gather' must be 'radius' or 'knn', got '" + gather + "'");
-    if (p.k < 1) throw Error(where, "setting 'k' must be at least 1, got " + std::to_string(p.k));
-    p.photon_map = parse_photon_map_kind(map, where + ": setting 'photon_map'");
-    p.hash_query = parse_hash_query(hash_query, where + ": setting 'hash_query'");
-    if (pass == "fused")
-        p.split = false;
-    else if (pass == "split")
-        p.split = true;
-    else
-        throw Error(where, "setting 'pass' must be 'fused' or 'split', got '" + pass + "'");
-    if (storage == "indirect")
-        p.storage = PhotonStorage::Indirect;
-    else if (storage == "every_hit")
-        p.storage = PhotonStorage::EveryHit;
-    else
-        throw Error(where, "setting 'photon_storage' must be 'indirect' or 'every_hit', got '" + storage + "'");
     const bool shared = p.tile_shared != TileShare::Off;
     if (shared && p.photon_map != PhotonMapKind::HashGrid)
         throw Error(where, "setting 'tile_shared' needs photon_map=hash_grid (it shares hash-grid cells), got " + map);
-    if (p.share_tile < 1)
-        throw Error(where, "setting 'share_tile' must be at least 1 pixel, got " + std::to_string(p.share_tile));
-    if (order != "cell" && order != "tiles")
-        throw Error(where, "setting 'gather_order' must be 'cell' or 'tiles', got '" + order + "'");
-    p.gather_by_tiles = order == "tiles";
-    if (order_given && !p.split)
+    if (order && !p.split)
         throw Error(where, "setting 'gather_order' orders the gather pass of pass=split; got pass=" + pass);
     if (p.tile_shared == TileShare::Paper && !p.gather_by_tiles)
         throw Error(where, "setting 'tile_shared=paper' shares per screen tile, so it needs gather_order=tiles");
     if (p.tile_shared == TileShare::CellGroups && p.gather_by_tiles)
         throw Error(where, "setting 'tile_shared=cell_groups' groups hits sorted by cell, so it needs gather_order=cell");
-    if (seed < 0) throw Error(where, "setting 'seed' must not be negative, got " + std::to_string(seed));
-    p.seed = uint64_t(seed);
-    if (p.light_samples < 0)
-        throw Error(where, "setting 'light_samples' must not be negative, got " + std::to_string(p.light_samples));
-    if (p.max_photon_depth < 1)
-        throw Error(where, "setting 'max_photon_depth' must be at least 1, got " + std::to_string(p.max_photon_depth));
-    if (p.tile_size < 1) throw Error(where, "setting 'tile_size' must be at least 1, got " + std::to_string(p.tile_size));
-    if (p.sampling.spp < 1) throw Error(where, "setting 'spp' must be at least 1, got " + std::to_string(p.sampling.spp));
-    if (p.sampling.spp > kMaxPhotonSpp)
-        throw Error(where, "setting 'spp' must be at most " + std::to_string(kMaxPhotonSpp) + ", got " +
-                               std::to_string(p.sampling.spp));
     if ((p.tile_shared == TileShare::Paper || p.gather_by_tiles) && p.tile_size % p.share_tile != 0)
         throw Error(where, "setting 'tile_shared=paper' needs a tile_size that is a multiple of share_tile (share tiles "
                            "nest in render tiles), got tile_size " + std::to_string(p.tile_size) + " and share_tile " +
                                std::to_string(p.share_tile));
-    if (match == "nearest")
-        p.stereo.match = StereoMatch::Nearest;
-    else if (match == "strict")
-        p.stereo.match = StereoMatch::Strict;
-    else
-        throw Error(where, "setting 'stereo_match' must be 'nearest' or 'strict', got '" + match + "'");
-    if (!(p.stereo.tolerance >= 0.0f) || !std::isfinite(p.stereo.tolerance))
-        throw Error(where, "setting 'stereo_tolerance' must be a finite number of pixels ≥ 0, got " + format_number(p.stereo.tolerance));
-    if (p.light_samples > 0xffff)
-        throw Error(where, "setting 'light_samples' must be at most 65535, got " + std::to_string(p.light_samples));
     if (p.foveation.enabled) {
-        const float angle = p.foveation.fovea_degrees;
-        if (!(angle > 0.0f && angle < 180.0f))
-            throw Error(where, "setting 'fovea_angle' must be in (0, 180) degrees, got " + format_number(angle));
-        for (auto [key, value] : {std::pair{"gaze_yaw", p.foveation.gaze_yaw_degrees},
-                                  std::pair{"gaze_pitch", p.foveation.gaze_pitch_degrees}})
-            if (!(std::abs(value) <= 90.0f))
-                throw Error(where, std::string("setting '") + key + "' must be within ±90 degrees, got " + format_number(value));
-        if (p.foveation.periphery_photon_stride < 1)
-            throw Error(where, "setting 'periphery_photon_stride' must be at least 1, got " +
-                                   std::to_string(p.foveation.periphery_photon_stride));
         if (p.split || shared)
             throw Error(where, "setting 'foveated' needs pass=fused and tile_shared=off (it picks the shading rate per block)");
         if (p.storage == PhotonStorage::EveryHit)

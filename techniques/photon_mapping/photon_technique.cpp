@@ -157,7 +157,8 @@ void register_photon_mapping(TechniqueRegistry& registry) {
     registry.add({"photon",
                   "photon mapping (P1): hash-grid / kd-tree / nanoflann photon map, radius or kNN gather, "
                   "indirect or every-hit photon storage, fused or split passes, tile-shared gather, progressive (SPPM)",
-                  [] { return std::make_unique<PhotonMappingTechnique>(); }});
+                  [] { return std::make_unique<PhotonMappingTechnique>(); },
+                  &PhotonMappingSettings::schema});
 }
 
 }  // namespace gilab

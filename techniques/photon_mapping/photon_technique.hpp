@@ -15,55 +15,42 @@
 //   indirect = the later-hit photons' estimate, the same quantity as in indirect mode.
 // Either way color = direct + indirect, the same split as the path tracer's layers.
 //
-// Settings: photons (emitted, 256·256), radius (3 % of the scene's bounding-box
-// diagonal), gather (radius | knn), k (128),
-// photon_map (hash_grid | kd_tree | nanoflann), hash_query (runs9 | cells27),
-// photon_storage (indirect | every_hit), pass (fused: trace and gather per pixel in one
-// loop | split: all primary hits into a buffer first, then a gather pass; bit-identical),
-// tile_shared (off | paper | cell_groups; tile_share.hpp; hash grid only; bit-identical:
-// paper = P1's Algorithm 1, a share_tile × share_tile screen tile fetches its cell's
-// neighbourhood once only if all its hits lie in one hash cell, else each hit gathers
-// alone; cell_groups = hits sharing a cell share one fetch, within a render tile (fused)
-// or across the image (split, hits sorted by cell). The JSON booleans of older settings
-// files still work: false = off, true = cell_groups), share_tile (8 pixels: P1 does not
-// give its thread-group size; tile_size must be a multiple of it with tile_shared=paper),
-// seed (1), light_samples (1), max_photon_depth (8: surface hits along a photon path),
-// tile_size (16), spp (1: primary rays per pixel, each with its own light samples, all
-// gathering from the frame's one photon map; every layer is the samples' mean; at most
-// 1024), jitter (true when spp > 1: positions uniform in the pixel | false: pixel
-// centres, so the default image is the one-ray-per-pixel render; pixel_samples.hpp).
-// Tile sharing and the split pass take a pixel's samples as more hits; stereo reuse and
-// foveation work per sample index (below). gather_order (pass=split only):
-// cell (the gather pass walks the hits sorted by hash cell; the default, and what
-// cell_groups needs) | tiles (it walks the share tiles in image order, the paper's hybrid
-// kernel: one thread group per tile; what tile_shared=paper needs, and its default).
-// With tile_shared=off both orders give the same image, so the paper's sharing can be
-// timed against a per-hit gather walking the same tiles.
+// Settings: PhotonMappingSettings::schema() declares every key with its default, range
+// and description (`gilab list settings photon`). How the modes combine:
+// * pass=split puts all primary hits into a buffer first, then a gather pass
+//   (bit-identical to fused). gather_order=cell walks the hits sorted by hash cell (what
+//   tile_shared=cell_groups needs); gather_order=tiles walks the share tiles in image
+//   order, the paper's hybrid kernel (what tile_shared=paper needs). With
+//   tile_shared=off both orders give the same image, so the paper's sharing can be timed
+//   against a per-hit gather walking the same tiles.
+// * tile_shared (tile_share.hpp; hash grid only; bit-identical): paper = P1's Algorithm
+//   1, a share_tile × share_tile screen tile fetches its cell's neighbourhood once only
+//   if all its hits lie in one hash cell, else each hit gathers alone; cell_groups = hits
+//   sharing a cell share one fetch, within a render tile (fused) or across the image
+//   (split, hits sorted by cell).
+// * spp > 1 (pixel_samples.hpp): each primary ray has its own light samples, all gather
+//   from the frame's one photon map, and every layer is the samples' mean. Tile sharing
+//   and the split pass take a pixel's samples as more hits; stereo reuse and foveation
+//   work per sample index (below).
 //
 // Stereo (a two-view render): the right eye draws its light samples from the stream of
 // the left pixel that sees the same point, so both eyes show the same noise on a surface
 // (no binocular rivalry from independent noise) and the stereo-reuse error below measures
-// geometry, not noise. stereo_reuse (false) fills right-eye pixels from the left eye's
-// hits (stereo_reuse.hpp); stereo_match (nearest: the paper's claim | strict: only where
-// the right pixel's own ray hits the same point within stereo_tolerance (0.5) pixel
-// footprints), stereo_reshade (true: re-evaluate the glossy lobe for the right eye;
-// false: copy the left colour, the paper's behaviour), stereo_fill (false: true fills
-// one-pixel reprojection cracks from neighbouring claims, nearest mode only). The right
+// geometry, not noise. stereo_reuse fills right-eye pixels from the left eye's hits
+// (stereo_reuse.hpp; stereo_match, stereo_tolerance, stereo_reshade, stereo_fill). The right
 // film gets a "reused" layer (the share of the pixel's samples that came from the left
 // eye; with spp > 1 sample s of the left pixels claims sample s of the right pixels); its
 // unclaimed pixels gather per hit whatever tile_shared says. With photon_storage=every_hit a
 // reshaded glossy pixel re-gathers both parts of the estimate for the right eye's
 // direction, a Lambertian one copies the left eye's direct and indirect light.
 //
-// Foveation (foveation.hpp): foveated (false), fovea_angle (10 degrees),
-// periphery_photon_stride (4), gaze_yaw / gaze_pitch (0 degrees: the eye's forward axis).
-// Needs pass=fused, tile_shared=off, photon_storage=indirect (it keeps direct light per
+// Foveation (foveation.hpp): gathers at full rate in the fovea, per 2×2 and 4×4 blocks
+// beyond, over a map of every periphery_photon_stride-th photon. Needs pass=fused, tile_shared=off, photon_storage=indirect (it keeps direct light per
 // pixel by shadow rays and shares only gathered indirect light) and a tile_size that is
 // a multiple of 4. With stereo_reuse the right eye's unclaimed pixels are gathered at the
 // full rate. With spp > 1 a block gathers once per surface for each sample index.
 //
-// Progressive mode (progressive.hpp; progressive_pass.cpp): progressive (false),
-// iterations (16), alpha (2/3), time_budget (seconds, optional); `radius` is the initial
+// Progressive mode (progressive.hpp; progressive_pass.cpp): `radius` is the initial
 // radius. Each iteration takes one jittered visible point per pixel (drawn as sample
 // `iteration` of the pixel would be with spp samples) and a fresh photon pass (photon
 // pass index = iteration). Direct light is the shadow-ray estimate, so it needs
@@ -120,8 +107,10 @@ struct PhotonMappingSettings {
     FoveationSettings foveation;
     ProgressiveSettings progressive;  // progressive.hpp
 
-    // Reads every key above (with get, so the caller can report the rest) and checks
-    // the values; throws Error naming the bad key.
+    // Every key with its default (the members above), range and description.
+    static const SettingsSchema& schema();
+    // Reads every key of the schema (with get, so the caller can report the rest) and
+    // checks the values and how they combine; throws Error naming the bad key.
     static PhotonMappingSettings from(const Settings& settings);
 };
 

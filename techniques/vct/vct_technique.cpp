@@ -162,70 +162,83 @@ Vec3 initial_viewer(const Scene& scene, const Bounds3& bounds) {
 
 // ---------------------------------------------------------------------------------
 
+const SettingsSchema& VctSettings::schema() {
+    static const SettingsSchema schema = [] {
+        const VctSettings d;
+        SettingsSchema s("vct", "voxel cone tracing on cascaded voxel textures (P3)");
+        s.choice("structure", "cascaded", {"cascaded", "dense"})
+            .doc("cascaded: P3's viewer-centred cascades | dense: one 3D texture with a full anisotropic mip chain "
+                 "(the VXGI-style baseline).");
+        s.integer("levels", d.levels).range(1, 16).unit("cascades").doc("Cascade levels, each twice the size of the last.");
+        s.integer("resolution", d.resolution).range(4, 1024).unit("voxels per axis, a power of two")
+            .doc("Resolution of every cascade.");
+        s.number("voxel_size", d.voxel_size).at_least(0).unit("scene units")
+            .doc("Finest voxel; 0: the scene's bounding cube / dense_resolution (shared by both structures).");
+        s.integer("dense_resolution", d.dense_resolution).range(2, 2048).unit("voxels per axis, a power of two")
+            .doc("Resolution of the dense texture.");
+        s.boolean("diffuse", d.diffuse).doc("Trace diffuse cones for indirect light.");
+        s.integer("diffuse_cones", d.diffuse_cones).range(1, 256).unit("per pixel")
+            .doc("Diffuse cones over the hemisphere.")
+            .quality_knob(1, 256);
+        s.boolean("specular", d.specular).doc("One cone along the mirror direction, its aperture from the Phong exponent.");
+        s.boolean("second_bounce", d.second_bounce).doc("Gather a bounce into the voxels before the final gather.");
+        s.integer("injection_cones", d.injection_cones).range(1, 256).unit("per voxel face")
+            .doc("Cones gathering the second bounce.");
+        s.number("ao_lambda", d.ao_lambda).at_least(0).doc("Eq. 4's ambient-occlusion fall-off per finest voxel of cone radius.");
+        s.number("cone_step", d.cone_step).above(0.01).at_most(4).unit("voxels of the sampled level")
+            .doc("Step between cone samples.");
+        s.number("cone_offset", d.cone_offset).range(0, 16).unit("voxels").doc("Cone apex moved off the surface along its normal.");
+        s.number("cone_start", d.cone_start).range(0, 16).unit("voxels").doc("First sample this far from the apex.");
+        s.boolean("opacity_correction", d.opacity_correction).doc("Correct each sample's opacity for the step length.");
+        s.number("lod_bias", d.lod_bias).doc("Added to every sample's mip level.");
+        s.boolean("clip_plane", d.clip_plane).doc("A cone ignores the back side of its own surface.");
+        s.boolean("blend_levels", d.blend_levels).doc("Blend the two cascade levels around a sample.");
+        s.number("max_distance", d.max_distance).at_least(0).unit("scene units").doc("Longest cone; 0: unbounded.");
+        s.choice("update", "strategy", {"strategy", "everything"})
+            .doc("strategy: level d re-centred on update_schedule with toroidal scrolling | everything: every level "
+                 "re-voxelized every frame.");
+        s.choice("update_schedule", "log2", {"log2", "pow2", "every"})
+            .doc("Frames between updates of level d: ⌈log2 d⌉ (P3 eq. 5), 2^(d−1), or 1.");
+        s.integer("light_samples", d.light_samples).range(1, 1024).doc("Samples per area-light evaluation.");
+        s.integer("seed", int64_t(d.seed)).at_least(0).doc("Seed of every random stream (same seed, same image).");
+        s.integer("tile_size", d.tile_size).at_least(1).unit("pixels").doc("Square screen tile of one parallel task.");
+        return s;
+    }();
+    return schema;
+}
+
 VctSettings VctSettings::from(const Settings& s) {
+    const SettingsSchema& schema = VctSettings::schema();
     VctSettings v;
     const std::string& where = s.context();
-    auto choose = [&](const std::string& key, const std::string& fallback, std::initializer_list<const char*> options) {
-        std::string value = s.get<std::string>(key, fallback);
-        std::string list;
-        for (const char* o : options) {
-            if (value == o) return value;
-            list += (list.empty() ? "" : ", ") + std::string(o);
-        }
-        throw Error(where, "setting '" + key + "' must be one of " + list + ", got '" + value + "'");
-    };
-    v.structure = choose("structure", "cascaded", {"cascaded", "dense"}) == "dense" ? Structure::Dense : Structure::Cascaded;
-    v.levels = s.get<int>("levels", v.levels);
-    v.resolution = s.get<int>("resolution", v.resolution);
-    v.voxel_size = s.get<double>("voxel_size", v.voxel_size);
-    v.dense_resolution = s.get<int>("dense_resolution", v.dense_resolution);
-    v.diffuse = s.get<bool>("diffuse", v.diffuse);
-    v.diffuse_cones = s.get<int>("diffuse_cones", v.diffuse_cones);
-    v.specular = s.get<bool>("specular", v.specular);
-    v.second_bounce = s.get<bool>("second_bounce", v.second_bounce);
-    v.injection_cones = s.get<int>("injection_cones", v.injection_cones);
-    v.ao_lambda = s.get<float>("ao_lambda", v.ao_lambda);
-    v.cone_step = s.get<float>("cone_step", v.cone_step);
-    v.cone_offset = s.get<float>("cone_offset", v.cone_offset);
-    v.cone_start = s.get<float>("cone_start", v.cone_start);
-    v.opacity_correction = s.get<bool>("opacity_correction", v.opacity_correction);
-    v.lod_bias = s.get<float>("lod_bias", v.lod_bias);
-    v.clip_plane = s.get<bool>("clip_plane", v.clip_plane);
-    v.blend_levels = s.get<bool>("blend_levels", v.blend_levels);
-    v.max_distance = s.get<float>("max_distance", v.max_distance);
-    v.update = choose("update", "strategy", {"strategy", "everything"}) == "everything" ? Update::Everything
-                                                                                       : Update::Strategy;
-    std::string schedule = choose("update_schedule", "log2", {"log2", "pow2", "every"});
+    v.structure = schema.get<std::string>(s, "structure") == "dense" ? Structure::Dense : Structure::Cascaded;
+    v.levels = schema.get<int>(s, "levels");
+    v.resolution = schema.get<int>(s, "resolution");
+    v.voxel_size = schema.get<double>(s, "voxel_size");
+    v.dense_resolution = schema.get<int>(s, "dense_resolution");
+    v.diffuse = schema.get<bool>(s, "diffuse");
+    v.diffuse_cones = schema.get<int>(s, "diffuse_cones");
+    v.specular = schema.get<bool>(s, "specular");
+    v.second_bounce = schema.get<bool>(s, "second_bounce");
+    v.injection_cones = schema.get<int>(s, "injection_cones");
+    v.ao_lambda = schema.get<float>(s, "ao_lambda");
+    v.cone_step = schema.get<float>(s, "cone_step");
+    v.cone_offset = schema.get<float>(s, "cone_offset");
+    v.cone_start = schema.get<float>(s, "cone_start");
+    v.opacity_correction = schema.get<bool>(s, "opacity_correction");
+    v.lod_bias = schema.get<float>(s, "lod_bias");
+    v.clip_plane = schema.get<bool>(s, "clip_plane");
+    v.blend_levels = schema.get<bool>(s, "blend_levels");
+    v.max_distance = schema.get<float>(s, "max_distance");
+    v.update = schema.get<std::string>(s, "update") == "everything" ? Update::Everything : Update::Strategy;
+    const std::string schedule = schema.get<std::string>(s, "update_schedule");
     v.schedule = schedule == "pow2" ? Schedule::Pow2 : schedule == "every" ? Schedule::Every : Schedule::Log2;
-    v.light_samples = s.get<int>("light_samples", v.light_samples);
-    int64_t seed = s.get<int64_t>("seed", int64_t(v.seed));
-    v.tile_size = s.get<int>("tile_size", v.tile_size);
-
-    auto fail = [&](const std::string& key, const std::string& rule, const std::string& got) {
-        throw Error(where, "setting '" + key + "' must be " + rule + ", got " + got);
-    };
-    if (v.levels < 1 || v.levels > 16) fail("levels", "1..16", std::to_string(v.levels));
-    if (v.resolution < 4 || v.resolution > 1024 || (v.resolution & (v.resolution - 1)))
-        fail("resolution", "a power of two in 4..1024", std::to_string(v.resolution));
-    if (!(v.voxel_size >= 0) || !std::isfinite(v.voxel_size))
-        fail("voxel_size", "0 (automatic) or a positive length", format_number(v.voxel_size));
-    if (v.dense_resolution < 2 || v.dense_resolution > 2048 || (v.dense_resolution & (v.dense_resolution - 1)))
-        fail("dense_resolution", "a power of two in 2..2048", std::to_string(v.dense_resolution));
-    if (v.diffuse_cones < 1 || v.diffuse_cones > 256) fail("diffuse_cones", "1..256", std::to_string(v.diffuse_cones));
-    if (v.injection_cones < 1 || v.injection_cones > 256)
-        fail("injection_cones", "1..256", std::to_string(v.injection_cones));
-    if (!(v.ao_lambda >= 0) || !std::isfinite(v.ao_lambda)) fail("ao_lambda", "non-negative", format_number(v.ao_lambda));
-    if (!(v.cone_step > 0.01f) || !(v.cone_step <= 4.0f)) fail("cone_step", "in (0.01, 4]", format_number(v.cone_step));
-    if (!(v.cone_offset >= 0) || !(v.cone_offset <= 16.0f))
-        fail("cone_offset", "in [0, 16] voxels", format_number(v.cone_offset));
-    if (!(v.cone_start >= 0) || !(v.cone_start <= 16.0f))
-        fail("cone_start", "in [0, 16] voxels", format_number(v.cone_start));
-    if (!(v.max_distance >= 0) || !std::isfinite(v.max_distance))
-        fail("max_distance", "0 (unbounded) or positive", format_number(v.max_distance));
-    if (v.light_samples < 1 || v.light_samples > 1024) fail("light_samples", "1..1024", std::to_string(v.light_samples));
-    if (seed < 0) fail("seed", "non-negative", std::to_string(seed));
-    if (v.tile_size < 1) fail("tile_size", "at least 1", std::to_string(v.tile_size));
-    v.seed = uint64_t(seed);
+    v.light_samples = schema.get<int>(s, "light_samples");
+    v.seed = uint64_t(schema.get<int64_t>(s, "seed"));
+    v.tile_size = schema.get<int>(s, "tile_size");
+    for (const auto& [key, value] : {std::pair{"resolution", v.resolution}, std::pair{"dense_resolution", v.dense_resolution}})
+        if (value & (value - 1))
+            throw Error(where, std::string("setting '") + key + "' must be a power of two, got " + std::to_string(value));
     return v;
 }
 
@@ -703,7 +716,7 @@ void register_vct(TechniqueRegistry& registry) {
     registry.add({"vct",
                   "voxel cone tracing on cascaded anisotropic voxel textures (P3); structure=dense gives the "
                   "mip-mapped 3D texture baseline",
-                  [] { return std::make_unique<VctTechnique>(); }});
+                  [] { return std::make_unique<VctTechnique>(); }, &VctSettings::schema});
 }
 
 }  // namespace gilab

@@ -23,18 +23,9 @@
 // through Embree. Emitters are not injected into the V-buffer: surfaces receive their
 // light through shadow rays, and injecting it too would count it twice.
 //
-// Settings (defaults): structure (cascaded | dense), levels (6), resolution (32),
-// voxel_size (0: the static scene's bounding cube / dense_resolution; cascades and the
-// dense texture then share the finest voxel and its lattice), dense_resolution (128),
-// diffuse (true), diffuse_cones (16), specular (true), second_bounce (true: voxel
-// bounce on), injection_cones (16), ao_lambda (0.1), cone_step (0.25 of the footprint),
-// cone_offset (1 voxel: apex moved off the surface along its normal), cone_start (1
-// voxel: first sample distance), clip_plane (true: a cone ignores the back side of its
-// own surface, see cone_tracer.hpp), blend_levels (false: a sample reads one level),
-// opacity_correction (false), lod_bias (0),
-// max_distance (0: until the cone leaves the structure), update (strategy |
-// everything), update_schedule (log2 | pow2 | every), light_samples (4 per area-light
-// evaluation), seed (1), tile_size (16).
+// Settings: VctSettings::schema() (`gilab list settings vct`). With voxel_size 0 the
+// cascades and the dense texture share the finest voxel and its lattice; clip_plane is
+// explained in cone_tracer.hpp.
 // Layers: color = direct + indirect + specular; direct (emission seen + direct light);
 // indirect (diffuse indirect); specular (glossy indirect); ao (1 channel, 1 = open);
 // albedo, normal, depth. Deterministic at any thread count.
@@ -83,6 +74,8 @@ struct VctSettings {
     uint64_t seed = 1;
     int tile_size = 16;
 
+    // Every key with its default (the members above), range and description.
+    static const SettingsSchema& schema();
     static VctSettings from(const Settings& settings);  // throws Error naming the bad key
 };
 

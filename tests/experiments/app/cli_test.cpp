@@ -258,7 +258,7 @@ TEST(Cli, RendersShadowsFromEveryStructure) {
     }
     const fs::path bad = gilab::test::temp_dir("cli_dag_shadows_bad");
     expect_failure("render fbm_terrain -t dag_shadows --set visibility=shadowmap -W 32 -H 32 -o " + (bad / "x").string(),
-                   {"dag_shadows.visibility", "shadowmap"}, bad);
+                   {"'visibility'", "shadowmap"}, bad);
 }
 
 TEST(Cli, PhotonTakesPixelSamplesAndTechniquesWithoutThemRefuseSpp) {
