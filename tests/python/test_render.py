@@ -132,3 +132,22 @@ def test_the_gil_is_released_while_rendering(cornell):
         ticks += 1  # runs only while the render does not hold the GIL
     worker.join()
     assert ticks > 1000
+
+
+def test_settings_schemas_are_listed_and_in_render_help():
+    """gilab.settings gives each technique's declared settings; help(gilab.render) shows them."""
+    names = [t["name"] for t in gilab.techniques()]
+    for name in names:
+        specs = gilab.settings(name)
+        assert specs, name
+        for spec in specs:
+            assert {"key", "type", "default", "range", "unit", "description", "quality_knob"} <= spec.keys()
+            assert spec["key"] in gilab.render.__doc__, (name, spec["key"])
+        assert name + ": " in gilab.render.__doc__
+    photon = {s["key"]: s for s in gilab.settings("photon")}
+    assert photon["photons"]["default"] == 65536 and photon["photons"]["quality_knob"]
+    assert photon["photon_map"]["choices"] == ["hash_grid", "kd_tree", "nanoflann"]
+    assert photon["radius"]["default"] is None and "diagonal" in photon["radius"]["derived_default"]
+    assert [s["key"] for s in gilab.settings("path") if s["quality_knob"]] == ["spp"]
+    with pytest.raises(gilab.Error, match="unknown technique"):
+        gilab.settings("nope")
