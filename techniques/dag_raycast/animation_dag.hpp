@@ -7,7 +7,7 @@
 // about the shared DAG plus one batch of cells. The all-at-once build (mode (a))
 // voxelizes whole frames, keeps every frame's SVDAG and merges them together at the end.
 #include <vector>
-#include "accel/dag/temporal_svdag.hpp"
+#include "accel/temporal/laid_out_multi_frame_dag.hpp"
 #include "core/scene/light.hpp"
 #include "core/scene/scene.hpp"
 #include "core/util/stats.hpp"
@@ -23,7 +23,7 @@ struct AnimationDagOptions {
 };
 
 struct AnimationDag {
-    TemporalSvdag dag;
+    LaidOutMultiFrameDag dag;
     std::vector<double> times;                       // scene time of each frame
     std::vector<std::vector<PunctualLight>> lights;  // world-space lights of each frame
     // build_ms (all of it: the bounds pass, voxelizing, merging, laying out),

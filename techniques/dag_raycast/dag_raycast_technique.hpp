@@ -34,7 +34,7 @@ public:
     void render(const ViewSet& views, std::vector<Film>& films) override;
     Stats stats() const override;
 
-    const TemporalSvdag& dag() const { return animation_.dag; }
+    const LaidOutMultiFrameDag& dag() const { return animation_.dag; }
     size_t frame() const { return frame_; }
     size_t frame_count() const { return animation_.times.size(); }
     double fps() const { return fps_; }

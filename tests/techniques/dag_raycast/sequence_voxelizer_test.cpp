@@ -252,7 +252,7 @@ TEST(SequenceVoxelizer, StreamedDagEqualsAllAtOnce) {
         frames.push_back(Svdag::from_voxels(grid, voxelize(scene.evaluate(t), grid).codes));
     }
     EXPECT_GT(reused, 0u);
-    const TemporalSvdag a = streamed.lay_out(), b = MultiFrameDag::merge_all(frames).lay_out();
+    const LaidOutMultiFrameDag a = streamed.lay_out(), b = MultiFrameDag::merge_all(frames).lay_out();
     EXPECT_EQ(a.node_count(), b.node_count());
     EXPECT_TRUE(std::ranges::equal(a.words(), b.words()));
 }
