@@ -15,7 +15,7 @@
 #include "python/array_helpers.hpp"
 #include "python/bindings.hpp"
 #include "python/loaded_scene.hpp"
-#include "techniques/dag_raycast/animation_dag.hpp"
+#include "accel/temporal/animation_dag.hpp"
 #include "techniques/dag_raycast/dag_raycast_settings.hpp"
 
 namespace gilab::python {

@@ -24,7 +24,7 @@
 #include "experiments/runner/experiment.hpp"
 #include "experiments/runner/measures.hpp"
 #include "scenes/scene_library.hpp"
-#include "techniques/dag_raycast/animation_dag.hpp"
+#include "accel/temporal/animation_dag.hpp"
 #include "techniques/technique.hpp"
 
 namespace gilab {

@@ -13,12 +13,10 @@
 // axis of each frame's shadow DAG), tile_size (16: image tile), seed (recorded only: nothing is random), spp (only 1: one
 // primary ray per pixel).
 #include <cstdint>
+#include "accel/temporal/animation_dag.hpp"
 #include "core/util/settings.hpp"
 
 namespace gilab {
-
-enum class DagBuildMode { Incremental, AllAtOnce };
-const char* to_string(DagBuildMode mode);
 
 // Where a lit surface's visibility comes from.
 enum class DagShadowSource {

@@ -18,7 +18,7 @@
 #include <vector>
 #include "accel/shadow/light_shadow_dags.hpp"
 #include "core/scene/light.hpp"
-#include "techniques/dag_raycast/animation_dag.hpp"
+#include "accel/temporal/animation_dag.hpp"
 #include "techniques/dag_raycast/dag_raycast_settings.hpp"
 #include "techniques/technique.hpp"
 

@@ -19,7 +19,7 @@
 #include "core/voxel/voxelizer.hpp"
 #include "scenes/fire_scene.hpp"
 #include "scenes/procedural_meshes.hpp"
-#include "techniques/dag_raycast/animation_dag.hpp"
+#include "accel/temporal/animation_dag.hpp"
 #include "tests/test_support.hpp"
 #include "tests/voxel_test_meshes.hpp"
 

@@ -11,9 +11,12 @@
 #include "core/scene/light.hpp"
 #include "core/scene/scene.hpp"
 #include "core/util/stats.hpp"
-#include "techniques/dag_raycast/dag_raycast_settings.hpp"
 
 namespace gilab {
+
+// How the frames are merged: Incremental is mode (b) above, AllAtOnce mode (a).
+enum class DagBuildMode { Incremental, AllAtOnce };
+const char* to_string(DagBuildMode mode);  // "incremental", "all_at_once"
 
 struct AnimationDagOptions {
     uint32_t resolution = 256;
