@@ -523,7 +523,9 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, bool dynamic_scen
 // ---------------------------------------------------------------------------------
 // Rendering experiments on Sponza.
 
-struct RenderSetup {
+// Sponza as the rendering experiments render it: the scene, its camera, the image size and
+// the dense texture's resolution.
+struct SponzaSetup {
     Scene scene;
     EyeCamera camera;
     int size = 0;
@@ -532,8 +534,8 @@ struct RenderSetup {
 
 // Sponza with the scene camera; the stone is made slightly glossy so the specular cone
 // has something to do (the scene file has one diffuse material).
-RenderSetup sponza_setup(const ExperimentContext& ctx, bool glossy) {
-    RenderSetup s;
+SponzaSetup sponza_setup(const ExperimentContext& ctx, bool glossy) {
+    SponzaSetup s;
     s.scene = open_scene("sponza", ctx.assets).scene;
     if (glossy)
         for (Material& m : s.scene.materials) {
@@ -603,7 +605,7 @@ std::vector<EyeCamera> walk_cameras(const Walk& walk, int size, int frames) {
     return cams;
 }
 
-std::vector<EyeCamera> sponza_path(const RenderSetup& s, int frames) { return walk_cameras(walks().at(0), s.size, frames); }
+std::vector<EyeCamera> sponza_path(const SponzaSetup& s, int frames) { return walk_cameras(walks().at(0), s.size, frames); }
 
 const char* kPhases[] = {"primary_ms", "update_ms", "injection_ms", "direct_ms", "diffuse_ms", "specular_ms", "total_ms"};
 
@@ -611,7 +613,7 @@ const char* kPhases[] = {"primary_ms", "update_ms", "injection_ms", "direct_ms",
 ExperimentOutput run_table7(const ExperimentContext& ctx) {
     ExperimentOutput out;
     quick_note(ctx, out);
-    RenderSetup s = sponza_setup(ctx, true);
+    SponzaSetup s = sponza_setup(ctx, true);
     const int frames = ctx.quick ? 2 : 5;
     struct Variant {
         std::string name;
@@ -898,7 +900,7 @@ ExperimentOutput run_fig10(const ExperimentContext& ctx) {
 ExperimentOutput run_fig11(const ExperimentContext& ctx) {
     ExperimentOutput out;
     quick_note(ctx, out);
-    RenderSetup s = sponza_setup(ctx, false);
+    SponzaSetup s = sponza_setup(ctx, false);
     const int spp = ctx.quick ? 32 : 512;
     // The shared, cached reference: its own seed, so it shares no samples with the run.
     Film reference = path_reference(ctx, s.scene, s.camera, spp, out.files);
@@ -931,7 +933,7 @@ ExperimentOutput run_fig11(const ExperimentContext& ctx) {
 ExperimentOutput run_fig12_13(const ExperimentContext& ctx) {
     ExperimentOutput out;
     quick_note(ctx, out);
-    RenderSetup s = sponza_setup(ctx, false);
+    SponzaSetup s = sponza_setup(ctx, false);
     ResultTable t;
     t.title = "Figs. 12/13 — diffuse (Sponza) and specular (Cornell box + glossy Buddha) cones on and off";
     t.columns = {"image", "mean_color", "mean_indirect", "mean_specular", "frame_ms"};
@@ -1009,7 +1011,7 @@ ExperimentOutput run_stability(const ExperimentContext& ctx) {
     ExperimentOutput out;
     quick_note(ctx, out);
     // (a) Flicker: relative frame-to-frame change of each layer along a slow walk.
-    RenderSetup s = sponza_setup(ctx, false);
+    SponzaSetup s = sponza_setup(ctx, false);
     const int frames = ctx.quick ? 3 : 16;
     if (ctx.quick) s.size = 32;
     std::vector<EyeCamera> cams;
