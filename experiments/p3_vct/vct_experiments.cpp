@@ -563,7 +563,7 @@ std::unique_ptr<Technique> make_vct(const Scene& scene, nlohmann::json settings,
 void quick_note(const ExperimentContext& ctx, ExperimentOutput& out) {
     if (ctx.quick)
         out.notes.push_back("Quick run: dense_resolution 64 (the finest voxel of both structures is 1/64 of the scene), "
-                            "48² images (32² along camera paths), 8 voxel-bounce cones instead of 16, fewer frames; "
+                            "48² images (32² along the camera walks), 8 voxel-bounce cones instead of 16, fewer frames; "
                             "at this size the dense texture is small, so memory and time ratios favour it.");
 }
 
@@ -580,22 +580,22 @@ void save_images(const ExperimentContext& ctx, ExperimentOutput& out, const std:
     out.files.push_back(name + ".png");
 }
 
-// The walks of Figs. 9–10, straight down each scene's nave, looking ahead and slightly
-// up. The paper walks through both of its dynamic scenes.
-struct Walk {
+// The camera walks of Figs. 9–10, straight down each scene's nave, looking ahead and
+// slightly up. The paper walks through both of its dynamic scenes.
+struct CameraWalk {
     std::string scene;
     Vec3 from, to, look;  // eye from → to, looking along `look`
     const char* description;
 };
-const std::vector<Walk>& walks() {
-    static const std::vector<Walk> w = {
+const std::vector<CameraWalk>& camera_walks() {
+    static const std::vector<CameraWalk> w = {
         {"sponza", {-10.0f, 2.0f, 0.3f}, {8.0f, 2.0f, 0.3f}, {6.0f, 1.2f, 0.0f}, "eye from (−10, 2, 0.3) to (8, 2, 0.3), looking +x"},
         {"sibenik", {14.0f, -10.5f, 0.0f}, {-6.0f, -10.5f, 0.0f}, {-6.0f, 0.8f, 0.0f},
          "eye from (14, −10.5, 0) to (−6, −10.5, 0), 2 m above the nave floor, looking −x towards the apse"}};
     return w;
 }
 
-std::vector<EyeCamera> walk_cameras(const Walk& walk, int size, int frames) {
+std::vector<EyeCamera> walk_cameras(const CameraWalk& walk, int size, int frames) {
     std::vector<EyeCamera> cams;
     for (int i = 0; i < frames; ++i) {
         const float t = frames > 1 ? float(i) / float(frames - 1) : 0.0f;
@@ -605,7 +605,9 @@ std::vector<EyeCamera> walk_cameras(const Walk& walk, int size, int frames) {
     return cams;
 }
 
-std::vector<EyeCamera> sponza_path(const SponzaSetup& s, int frames) { return walk_cameras(walks().at(0), s.size, frames); }
+std::vector<EyeCamera> sponza_walk_cameras(const SponzaSetup& s, int frames) {
+    return walk_cameras(camera_walks().at(0), s.size, frames);
+}
 
 const char* kPhases[] = {"primary_ms", "update_ms", "injection_ms", "direct_ms", "diffuse_ms", "specular_ms", "total_ms"};
 
@@ -637,7 +639,7 @@ ExperimentOutput run_table7(const ExperimentContext& ctx) {
         }
     // The update matters when the viewer moves: timed on the walk down the nave, where the
     // cascades scroll (a fixed camera would leave them nothing to do).
-    const std::vector<EyeCamera> walk = sponza_path(s, ctx.quick ? 3 : 12);
+    const std::vector<EyeCamera> walk = sponza_walk_cameras(s, ctx.quick ? 3 : 12);
     std::vector<std::vector<double>> walk_update(variants.size());
     for (size_t v = 0; v < variants.size(); ++v) {
         auto moving = make_vct(s.scene, variants[v].settings, ctx);
@@ -694,30 +696,32 @@ const nlohmann::json& walk_photon_settings() {
     return s;
 }
 
-struct PathRun {
+// One variant rendered along one camera walk: its figures frame by frame.
+struct CameraWalkRun {
     std::string name;
     std::vector<double> total_ms, update_ms, injection_ms, bytes, rss;
 };
 
-struct WalkRuns {
+// Every variant along one scene's camera walk.
+struct CameraWalkRuns {
     std::string scene;
-    const Walk* walk = nullptr;
-    std::vector<PathRun> runs;  // dense mip, cascaded everything, cascaded strategy, photon
+    const CameraWalk* walk = nullptr;
+    std::vector<CameraWalkRun> runs;  // dense mip, cascaded everything, cascaded strategy, photon
 };
 
 // One walk per scene, shared by Figs. 9 and 10; scenes whose mesh is missing are skipped
 // with a note.
-const std::vector<WalkRuns>& path_runs(const ExperimentContext& ctx, ExperimentOutput& out) {
-    static std::map<RunKey, std::pair<std::vector<WalkRuns>, std::vector<std::string>>> cache;
+const std::vector<CameraWalkRuns>& camera_walk_runs(const ExperimentContext& ctx, ExperimentOutput& out) {
+    static std::map<RunKey, std::pair<std::vector<CameraWalkRuns>, std::vector<std::string>>> cache;
     const RunKey key = run_key(ctx);
     auto it = cache.find(key);
     if (it == cache.end()) {
-        std::vector<WalkRuns> all;
+        std::vector<CameraWalkRuns> all;
         ExperimentOutput scratch;
-        for (const Walk& walk : walks()) {
+        for (const CameraWalk& walk : camera_walks()) {
             std::optional<Scene> scene = try_scene(ctx, walk.scene, scratch, false);
             if (!scene) continue;
-            WalkRuns w;
+            CameraWalkRuns w;
             w.scene = walk.scene;
             w.walk = &walk;
             const int size = ctx.quick ? 32 : 192, dense_resolution = ctx.quick ? 64 : 128;
@@ -727,7 +731,7 @@ const std::vector<WalkRuns>& path_runs(const ExperimentContext& ctx, ExperimentO
                 {"cascaded, update everything", {{"dense_resolution", dense_resolution}, {"update", "everything"}}},
                 {"cascaded, update strategy", {{"dense_resolution", dense_resolution}, {"update", "strategy"}}}};
             for (const auto& [name, settings] : variants) {
-                PathRun run;
+                CameraWalkRun run;
                 run.name = name;
                 auto t = make_vct(*scene, settings, ctx);
                 for (const EyeCamera& cam : cams) {
@@ -744,7 +748,7 @@ const std::vector<WalkRuns>& path_runs(const ExperimentContext& ctx, ExperimentO
             {
                 // The photon map is traced and built at prepare; the cone-traced variants
                 // inject light every frame, so each photon frame is charged that pass too.
-                PathRun run;
+                CameraWalkRun run;
                 run.name = "photon mapping";
                 auto t = TechniqueRegistry::builtin().create("photon");
                 nlohmann::json settings = walk_photon_settings();
@@ -765,7 +769,7 @@ const std::vector<WalkRuns>& path_runs(const ExperimentContext& ctx, ExperimentO
                 }
                 w.runs.push_back(std::move(run));
             }
-            for (const PathRun& r : w.runs)
+            for (const CameraWalkRun& r : w.runs)
                 ctx.say(walk.scene + ", " + r.name + ": mean frame " + std::to_string(mean(r.total_ms)) + " ms");
             all.push_back(std::move(w));
         }
@@ -783,22 +787,22 @@ std::vector<double> after_first(const std::vector<double>& v) {
 ExperimentOutput run_fig9(const ExperimentContext& ctx) {
     ExperimentOutput out;
     quick_note(ctx, out);
-    const auto& walk_runs = path_runs(ctx, out);
+    const auto& walk_runs = camera_walk_runs(ctx, out);
     ResultTable summary;
     summary.title = "Fig. 9 summary — mean over each walk (first frame excluded: every variant starts from a full build)";
     summary.columns = {"scene", "variant", "frame_ms", "update_ms", "injection_ms", "fps", "paper"};
-    for (const WalkRuns& w : walk_runs) {
+    for (const CameraWalkRuns& w : walk_runs) {
         const auto& runs = w.runs;
         ResultTable t;
         t.title = "Fig. 9 — frame time along a walk through " + w.scene;
         t.columns = {"frame"};
-        for (const PathRun& r : runs) {
+        for (const CameraWalkRun& r : runs) {
             t.columns.push_back(r.name + " ms");
             t.columns.push_back(r.name + " fps");
         }
         for (size_t f = 0; f < runs[0].total_ms.size(); ++f) {
             nlohmann::json row = {{"frame", f + 1}};
-            for (const PathRun& r : runs) {
+            for (const CameraWalkRun& r : runs) {
                 row[r.name + " ms"] = r.total_ms[f];
                 row[r.name + " fps"] = 1000.0 / r.total_ms[f];
             }
@@ -806,13 +810,13 @@ ExperimentOutput run_fig9(const ExperimentContext& ctx) {
         }
         out.tables.push_back(t);
         Plot plot{"Fig. 9 — frame time along the walk through " + w.scene, "frame", "frame time (ms, log scale)", false, true, {}};
-        for (const PathRun& r : runs) {
+        for (const CameraWalkRun& r : runs) {
             PlotSeries series{r.name, {}, r.total_ms, false, true, -1};
             for (size_t f = 0; f < r.total_ms.size(); ++f) series.x.push_back(double(f + 1));
             plot.series.push_back(std::move(series));
         }
         out.plots.push_back({"fig9_" + w.scene, std::move(plot)});
-        for (const PathRun& r : runs) {
+        for (const CameraWalkRun& r : runs) {
             const double ms = mean(after_first(r.total_ms));
             const char* paper = r.name == "dense mip"                   ? "VXGI ≈ 10 fps below cascaded + strategy"
                                 : r.name == "cascaded, update strategy" ? "fastest; update ≈ 2.0 ms vs VXGI 15.5 ms"
@@ -832,9 +836,9 @@ ExperimentOutput run_fig9(const ExperimentContext& ctx) {
                                 {"fps", nullptr}, {"paper", "15.5 / 2.0 = 7.8 (VXGI vs cascaded)"}});
     }
     out.tables.push_back(summary);
-    nlohmann::json paths = nlohmann::json::object();
-    for (const WalkRuns& w : walk_runs) paths[w.scene] = w.walk->description;
-    out.config = {{"scenes", paths},
+    nlohmann::json walks = nlohmann::json::object();
+    for (const CameraWalkRuns& w : walk_runs) walks[w.scene] = w.walk->description;
+    out.config = {{"scenes", walks},
                   {"frames", walk_runs[0].runs[0].total_ms.size()},
                   {"image", ctx.quick ? "32²" : "192²"},
                   {"photon", walk_photon_settings()}};
@@ -850,27 +854,27 @@ ExperimentOutput run_fig9(const ExperimentContext& ctx) {
 ExperimentOutput run_fig10(const ExperimentContext& ctx) {
     ExperimentOutput out;
     quick_note(ctx, out);
-    const auto& walk_runs = path_runs(ctx, out);
+    const auto& walk_runs = camera_walk_runs(ctx, out);
     ResultTable summary;
     summary.title = "Fig. 10 summary — mean structure memory over each walk, each variant ÷ dense";
     summary.columns = {"scene", "variant", "mean structure (MB)", "over_dense", "paper over_dense"};
-    for (const WalkRuns& w : walk_runs) {
+    for (const CameraWalkRuns& w : walk_runs) {
         const auto& runs = w.runs;
         ResultTable t;
         t.title = "Fig. 10 — memory along the walk through " + w.scene + " (MB = 10⁶ B, of each structure; process RSS)";
         t.columns = {"frame"};
-        for (const PathRun& r : runs) t.columns.push_back(r.name + " (MB)");
+        for (const CameraWalkRun& r : runs) t.columns.push_back(r.name + " (MB)");
         t.columns.push_back("process RSS (MB)");
         for (size_t f = 0; f < runs[0].bytes.size(); ++f) {
             nlohmann::json row = {{"frame", f + 1}};
-            for (const PathRun& r : runs) row[r.name + " (MB)"] = mb(r.bytes[f]);
+            for (const CameraWalkRun& r : runs) row[r.name + " (MB)"] = mb(r.bytes[f]);
             row["process RSS (MB)"] = mb(runs.back().rss[f]);
             t.rows.push_back(row);
         }
         out.tables.push_back(t);
         Plot plot{"Fig. 10 — structure memory along the walk through " + w.scene, "frame", "memory (MB = 10⁶ B, log scale)",
                   false, true, {}};
-        for (const PathRun& r : runs) {
+        for (const CameraWalkRun& r : runs) {
             PlotSeries series{r.name, {}, {}, false, true, -1};
             for (size_t f = 0; f < r.bytes.size(); ++f) {
                 series.x.push_back(double(f + 1));
@@ -879,7 +883,7 @@ ExperimentOutput run_fig10(const ExperimentContext& ctx) {
             plot.series.push_back(std::move(series));
         }
         out.plots.push_back({"fig10_" + w.scene, std::move(plot)});
-        for (const PathRun& r : runs)
+        for (const CameraWalkRun& r : runs)
             summary.rows.push_back({{"scene", w.scene},
                                     {"variant", r.name},
                                     {"mean structure (MB)", mb(mean(r.bytes))},
