@@ -292,20 +292,24 @@ SceneFigures measure_structures(const ExperimentContext& ctx, const Scene& scene
 using RunKey = std::tuple<bool, std::string, uint64_t, int>;
 RunKey run_key(const ExperimentContext& ctx) { return {ctx.quick, ctx.assets.describe(), ctx.seed, ctx.threads}; }
 
+// The paper's two sets of scenes for Tables 1–6: the Stanford models in the Cornell box
+// (Tables 1, 3, 5, its static scenes) and Sponza and Sibenik (Tables 2, 4, 6, its dynamic
+// scenes, static here).
+enum class SceneSet { StanfordModelsInCornellBox, SponzaAndSibenik };
+
 // Results are kept for the process, so Tables 1, 3 and 5 (and 2, 4, 6) share one run.
-const std::vector<SceneFigures>& structure_figures(const ExperimentContext& ctx, bool dynamic_scenes,
-                                                   ExperimentOutput& out) {
-    using Key = std::pair<bool, RunKey>;
+const std::vector<SceneFigures>& structure_figures(const ExperimentContext& ctx, SceneSet set, ExperimentOutput& out) {
+    using Key = std::pair<SceneSet, RunKey>;
     static std::map<Key, std::vector<SceneFigures>> cache;
     static std::map<Key, std::vector<std::string>> cached_notes;
-    const Key key{dynamic_scenes, run_key(ctx)};
+    const Key key{set, run_key(ctx)};
     auto it = cache.find(key);
     if (it == cache.end()) {
         std::vector<SceneFigures> figures;
         ExperimentOutput scratch;
         std::vector<std::pair<std::string, bool>> scenes;  // (name, inside the Cornell box)
         std::vector<int> resolutions;
-        if (dynamic_scenes) {
+        if (set == SceneSet::SponzaAndSibenik) {
             scenes = {{"sponza", false}, {"sibenik", false}};
             resolutions = ctx.quick ? std::vector<int>{128, 256} : std::vector<int>{256, 512};
         } else {
@@ -392,15 +396,16 @@ const char* fixed_by_construction(const std::string& structure) {
     return structure == "3D texture" ? "yes: resolution³" : structure == "cascaded" ? "yes: levels × 32³" : "no";
 }
 
-ExperimentOutput structure_table(const ExperimentContext& ctx, bool dynamic_scenes, Figure figure) {
+ExperimentOutput structure_table(const ExperimentContext& ctx, SceneSet set, Figure figure) {
     ExperimentOutput out;
-    const auto& figures = structure_figures(ctx, dynamic_scenes, out);
-    const PaperTable& paper = dynamic_scenes ? paper_dynamic() : paper_static();
-    const int table = (figure == Figure::Count ? 1 : figure == Figure::Time ? 3 : 5) + (dynamic_scenes ? 1 : 0);
+    const bool sponza_and_sibenik = set == SceneSet::SponzaAndSibenik;
+    const auto& figures = structure_figures(ctx, set, out);
+    const PaperTable& paper = sponza_and_sibenik ? paper_dynamic() : paper_static();
+    const int table = (figure == Figure::Count ? 1 : figure == Figure::Time ? 3 : 5) + (sponza_and_sibenik ? 1 : 0);
     ResultTable t;
     const char* what[] = {"voxel counts (×10⁶)", "voxelization time (ms)", "memory (MB = 10⁶ B, each structure's real encoding)"};
     t.title = "Table " + std::to_string(table) + " — " + what[int(figure)] + ", " +
-              (dynamic_scenes ? "Sponza and Sibenik" : "Cornell box + Stanford models");
+              (sponza_and_sibenik ? "Sponza and Sibenik" : "Cornell box + Stanford models");
     switch (figure) {
         case Figure::Count:
             t.columns = {"scene", "resolution", "structure", "voxels_millions", "occupied_millions", "paper voxels_millions",
@@ -421,7 +426,7 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, bool dynamic_scen
         const std::string model = model_of(sf.scene);
         // The paper's resolution pair: 128/256 (static), 256/512 (Sponza); quick runs use
         // half those and are compared with the paper's first column only when they match.
-        const int paper_first = dynamic_scenes ? 256 : 128;
+        const int paper_first = sponza_and_sibenik ? 256 : 128;
         int column = sf.resolution == paper_first ? 0 : sf.resolution == 2 * paper_first ? 1 : -1;
         for (const std::string& s : kStructures) {
             const StructureFigures& f = sf.by_structure.at(s);
@@ -463,7 +468,7 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, bool dynamic_scen
         ratio.title = "Speed-up of the cascaded voxelization over the dense 3D texture (same run)";
         ratio.columns = {"scene", "resolution", "dense_over_cascaded", "paper dense_over_cascaded"};
         for (const SceneFigures& sf : figures) {
-            const int paper_first = dynamic_scenes ? 256 : 128;
+            const int paper_first = sponza_and_sibenik ? 256 : 128;
             int column = sf.resolution == paper_first ? 0 : sf.resolution == 2 * paper_first ? 1 : -1;
             const std::string model = model_of(sf.scene);
             nlohmann::json pr;
@@ -476,7 +481,7 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, bool dynamic_scen
         }
         out.tables.push_back(ratio);
     }
-    out.config = {{"resolutions", dynamic_scenes ? (ctx.quick ? "128³, 256³" : "256³, 512³") : (ctx.quick ? "64³, 128³" : "128³, 256³")},
+    out.config = {{"resolutions", sponza_and_sibenik ? (ctx.quick ? "128³, 256³" : "256³, 512³") : (ctx.quick ? "64³, 128³" : "128³, 256³")},
                   {"cascade", "32³ per level, levels = log2(resolution/32) + 1, finest voxel = grid voxel, centred on the scene camera if it is inside the scene, else on the scene's centre"},
                   {"repeats", ctx.quick ? 1 : 3},
                   {"statistic", "median"}};
@@ -508,7 +513,7 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, bool dynamic_scen
             "cells'. The paper's own figures do not all follow it: its cascades do (0.56 MiB ≈ 3 × 32³ × 6 B), its 3D "
             "texture charges 1 B per cell (2 MiB at 128³), and its sparse structures imply other figures per node "
             "(column 'paper bytes per node or cell').");
-    if (dynamic_scenes)
+    if (sponza_and_sibenik)
         out.notes.push_back("Sponza is Dabrovic's 2002 original (66 454 triangles; the paper's is Meinl's 262 k-triangle "
                             "re-model) and Sibenik Dabrovic's cathedral (75 284 triangles), both static here; the paper's "
                             "were animated. The paper's Table 4 heads its Sibenik columns 128³ / 256³ while Tables 2 and "
@@ -1098,17 +1103,17 @@ ExperimentOutput run_stability(const ExperimentContext& ctx) {
 
 void register_vct_experiments(ExperimentRegistry& registry) {
     registry.add({"vct-table1", "P3", "voxel counts: 3D texture, SVO, MSVO (OctoMap), SVDAG, OpenVDB, cascaded — Cornell + Stanford models",
-                  [](const ExperimentContext& ctx) { return structure_table(ctx, false, Figure::Count); }});
+                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::StanfordModelsInCornellBox, Figure::Count); }});
     registry.add({"vct-table2", "P3", "voxel counts on Sponza and Sibenik (256³/512³)",
-                  [](const ExperimentContext& ctx) { return structure_table(ctx, true, Figure::Count); }});
+                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::SponzaAndSibenik, Figure::Count); }});
     registry.add({"vct-table3", "P3", "voxelization time by structure — Cornell + Stanford models",
-                  [](const ExperimentContext& ctx) { return structure_table(ctx, false, Figure::Time); }});
+                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::StanfordModelsInCornellBox, Figure::Time); }});
     registry.add({"vct-table4", "P3", "voxelization time by structure — Sponza and Sibenik",
-                  [](const ExperimentContext& ctx) { return structure_table(ctx, true, Figure::Time); }});
+                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::SponzaAndSibenik, Figure::Time); }});
     registry.add({"vct-table5", "P3", "memory, each structure in its real encoding, with the paper's implied bytes per node — Cornell + Stanford models",
-                  [](const ExperimentContext& ctx) { return structure_table(ctx, false, Figure::Memory); }});
+                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::StanfordModelsInCornellBox, Figure::Memory); }});
     registry.add({"vct-table6", "P3", "memory, each structure in its real encoding — Sponza and Sibenik",
-                  [](const ExperimentContext& ctx) { return structure_table(ctx, true, Figure::Memory); }});
+                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::SponzaAndSibenik, Figure::Memory); }});
     registry.add({"vct-table7", "P3", "per-frame phase times, dense mip VCT vs cascaded (Sponza)", run_table7});
     registry.add({"vct-fig9", "P3", "frame time along walks through Sponza and Sibenik: dense, cascaded without/with the update strategy, photon mapping", run_fig9});
     registry.add({"vct-fig10", "P3", "structure memory along the walks through Sponza and Sibenik", run_fig10});
