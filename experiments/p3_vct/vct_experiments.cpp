@@ -382,7 +382,9 @@ std::string model_of(const std::string& scene_name) {
     return plus == std::string::npos ? scene_name : scene_name.substr(plus + 1);
 }
 
-enum class Figure { Count, Time, Memory };
+// What a structure table reports: voxel counts (Tables 1–2), voxelization times (3–4) or
+// memory (5–6).
+enum class StructureQuantity { VoxelCount, VoxelizationTime, Memory };
 
 // The paper's memory accounting applied to every structure alike: opacity only, 1 byte
 // per voxel face, 6 faces per node or cell. It puts all structures on the paper's footing
@@ -396,26 +398,30 @@ const char* fixed_by_construction(const std::string& structure) {
     return structure == "3D texture" ? "yes: resolution³" : structure == "cascaded" ? "yes: levels × 32³" : "no";
 }
 
-ExperimentOutput structure_table(const ExperimentContext& ctx, SceneSet set, Figure figure) {
+ExperimentOutput structure_table(const ExperimentContext& ctx, SceneSet set, StructureQuantity quantity) {
     ExperimentOutput out;
     const bool sponza_and_sibenik = set == SceneSet::SponzaAndSibenik;
     const auto& figures = structure_figures(ctx, set, out);
     const PaperTable& paper = sponza_and_sibenik ? paper_dynamic() : paper_static();
-    const int table = (figure == Figure::Count ? 1 : figure == Figure::Time ? 3 : 5) + (sponza_and_sibenik ? 1 : 0);
+    // The Stanford models' table is 1, 3 or 5; Sponza and Sibenik's is the next one.
+    const int models_table = quantity == StructureQuantity::VoxelCount         ? 1
+                             : quantity == StructureQuantity::VoxelizationTime ? 3
+                                                                               : 5;
+    const int table = models_table + (sponza_and_sibenik ? 1 : 0);
     ResultTable t;
     const char* what[] = {"voxel counts (×10⁶)", "voxelization time (ms)", "memory (MB = 10⁶ B, each structure's real encoding)"};
-    t.title = "Table " + std::to_string(table) + " — " + what[int(figure)] + ", " +
+    t.title = "Table " + std::to_string(table) + " — " + what[int(quantity)] + ", " +
               (sponza_and_sibenik ? "Sponza and Sibenik" : "Cornell box + Stanford models");
-    switch (figure) {
-        case Figure::Count:
+    switch (quantity) {
+        case StructureQuantity::VoxelCount:
             t.columns = {"scene", "resolution", "structure", "voxels_millions", "occupied_millions", "paper voxels_millions",
                          "fixed by construction"};
             break;
-        case Figure::Time:
+        case StructureQuantity::VoxelizationTime:
             t.columns = {"scene", "resolution", "structure", "voxelize_ms (overlap voxelizer)",
                          "voxelize_ms (fragment voxelizer)", "paper voxelize_ms"};
             break;
-        case Figure::Memory:
+        case StructureQuantity::Memory:
             t.columns = {"scene", "resolution", "structure", "encoding", "nodes or cells (×10⁶)", "bytes per node or cell",
                          "memory (MB, real encoding)", kPaperAccountingColumn, "all arrays held (MB)",
                          "paper memory (MiB, printed as MB)",
@@ -434,19 +440,19 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, SceneSet set, Fig
             std::optional<PaperCell> p;
             if (column >= 0 && paper.count(model) && paper.at(model).count(s))
                 p = paper.at(model).at(s)[size_t(column)];
-            switch (figure) {
-                case Figure::Count:
+            switch (quantity) {
+                case StructureQuantity::VoxelCount:
                     r["voxels_millions"] = f.voxels / 1e6;
                     r["occupied_millions"] = f.occupied / 1e6;
                     r["paper voxels_millions"] = p ? nlohmann::json(p->voxels_m) : nlohmann::json();
                     r["fixed by construction"] = fixed_by_construction(s);
                     break;
-                case Figure::Time:
+                case StructureQuantity::VoxelizationTime:
                     r["voxelize_ms (overlap voxelizer)"] = std::isnan(f.ms_overlap) ? nlohmann::json() : nlohmann::json(f.ms_overlap);
                     r["voxelize_ms (fragment voxelizer)"] = std::isnan(f.ms_fragment) ? nlohmann::json() : nlohmann::json(f.ms_fragment);
                     r["paper voxelize_ms"] = p ? nlohmann::json(p->ms) : nlohmann::json();
                     break;
-                case Figure::Memory:
+                case StructureQuantity::Memory:
                     r["encoding"] = encodings().at(s);
                     r["nodes or cells (×10⁶)"] = f.voxels / 1e6;
                     r["bytes per node or cell"] = f.encoded_bytes / f.voxels;
@@ -463,7 +469,7 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, SceneSet set, Fig
         }
     }
     out.tables.push_back(t);
-    if (figure == Figure::Time) {
+    if (quantity == StructureQuantity::VoxelizationTime) {
         ResultTable ratio;
         ratio.title = "Speed-up of the cascaded voxelization over the dense 3D texture (same run)";
         ratio.columns = {"scene", "resolution", "dense_over_cascaded", "paper dense_over_cascaded"};
@@ -506,7 +512,7 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, SceneSet set, Fig
         "(the paper counts 1 B per face: 6 B per cell). 'all arrays held' adds, for the cascades, every G-buffer "
         "attribute and both radiance buffers. The paper's MB are 2²⁰ B (its 3D texture at 128³, 2 097 152 B, is "
         "printed as 2 MB), ours 10⁶ B; its bytes per node are implied by dividing its memory by its own count.");
-    if (figure == Figure::Memory)
+    if (quantity == StructureQuantity::Memory)
         out.notes.push_back(
             std::string("'") + kPaperAccountingColumn + "': the paper's stated accounting (opacity only, 1 byte per "
             "voxel per face) applied to every structure alike, 6 B per node or cell as counted in column 'nodes or "
@@ -1103,17 +1109,17 @@ ExperimentOutput run_stability(const ExperimentContext& ctx) {
 
 void register_vct_experiments(ExperimentRegistry& registry) {
     registry.add({"vct-table1", "P3", "voxel counts: 3D texture, SVO, MSVO (OctoMap), SVDAG, OpenVDB, cascaded — Cornell + Stanford models",
-                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::StanfordModelsInCornellBox, Figure::Count); }});
+                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::StanfordModelsInCornellBox, StructureQuantity::VoxelCount); }});
     registry.add({"vct-table2", "P3", "voxel counts on Sponza and Sibenik (256³/512³)",
-                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::SponzaAndSibenik, Figure::Count); }});
+                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::SponzaAndSibenik, StructureQuantity::VoxelCount); }});
     registry.add({"vct-table3", "P3", "voxelization time by structure — Cornell + Stanford models",
-                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::StanfordModelsInCornellBox, Figure::Time); }});
+                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::StanfordModelsInCornellBox, StructureQuantity::VoxelizationTime); }});
     registry.add({"vct-table4", "P3", "voxelization time by structure — Sponza and Sibenik",
-                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::SponzaAndSibenik, Figure::Time); }});
+                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::SponzaAndSibenik, StructureQuantity::VoxelizationTime); }});
     registry.add({"vct-table5", "P3", "memory, each structure in its real encoding, with the paper's implied bytes per node — Cornell + Stanford models",
-                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::StanfordModelsInCornellBox, Figure::Memory); }});
+                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::StanfordModelsInCornellBox, StructureQuantity::Memory); }});
     registry.add({"vct-table6", "P3", "memory, each structure in its real encoding — Sponza and Sibenik",
-                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::SponzaAndSibenik, Figure::Memory); }});
+                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::SponzaAndSibenik, StructureQuantity::Memory); }});
     registry.add({"vct-table7", "P3", "per-frame phase times, dense mip VCT vs cascaded (Sponza)", run_table7});
     registry.add({"vct-fig9", "P3", "frame time along walks through Sponza and Sibenik: dense, cascaded without/with the update strategy, photon mapping", run_fig9});
     registry.add({"vct-fig10", "P3", "structure memory along the walks through Sponza and Sibenik", run_fig10});
