@@ -13,7 +13,7 @@
 #include <tuple>
 #include <limits>
 #include <tbb/parallel_sort.h>
-#include "accel/vct/anisotropic_voxelizer.hpp"
+#include "accel/vct/fragment_voxelizer.hpp"
 #include "accel/vct/cascaded_voxel_texture.hpp"
 #include "accel/peers/octomap_tree.hpp"
 #include "accel/peers/openvdb_grid.hpp"
@@ -105,7 +105,7 @@ struct StructureFigures {
     // The time from each voxelizer, so structures compare under one voxelizer; NaN where
     // a structure cannot be built from that voxelizer's output.
     double ms_overlap = std::numeric_limits<double>::quiet_NaN();   // core/voxel/voxelizer (triangle/box overlap)
-    double ms_fragment = std::numeric_limits<double>::quiet_NaN();  // anisotropic fragment voxelizer
+    double ms_fragment = std::numeric_limits<double>::quiet_NaN();  // fragment voxelizer (accel/vct/fragment_voxelizer)
 };
 struct SceneFigures {
     std::string scene;
@@ -182,7 +182,7 @@ SceneFigures measure_structures(const ExperimentContext& ctx, const Scene& scene
 
     // Dense 3D texture: fragment voxelization of the whole grid written into one byte of
     // opacity per voxel (the isotropic texture the paper counts).
-    const AnisotropicVoxelizer fragments(frame, scene.materials);
+    const FragmentVoxelizer fragments(frame, scene.materials);
     std::vector<uint8_t> texture;
     double dense_occupied = 0;
     for (int r = 0; r < repeats; ++r) {
