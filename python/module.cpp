@@ -43,7 +43,7 @@ These bindings wrap the C++ code; they compute nothing of their own:
   experiments, run_experiment          the experiment runner
   voxelize, VoxelList, Svo, Esvo, Svdag   sparse voxel structures
   ShadowDag                            shadow DAG over a light's light space
-  MultiFrameDag, TemporalSvdag,        time-correlated multi-frame DAG
+  MultiFrameDag, LaidOutMultiFrameDag  time-correlated multi-frame DAG
   build_animation_dag
   PhotonMap                            photon maps with radius / kNN queries
   relative_mse, ssim, flip             image metrics on NumPy arrays

@@ -1,6 +1,6 @@
 // The time-correlated multi-frame DAG (P2 §4) on its own: gilab.MultiFrameDag (frames
 // merged across space and time, appended or replaced one at a time, or merged all at
-// once from per-frame SVDAGs), gilab.TemporalSvdag (its 32-bit layout, with per-frame
+// once from per-frame SVDAGs), gilab.LaidOutMultiFrameDag (its 32-bit layout, with per-frame
 // decoding and point queries) and gilab.build_animation_dag (every frame of an animated
 // scene, as the dag_raycast technique and dag-table5 build it).
 #include <algorithm>
@@ -9,13 +9,13 @@
 #include <pybind11/stl.h>
 #include "accel/temporal/multi_frame_dag.hpp"
 #include "accel/dag/svdag.hpp"
-#include "accel/dag/temporal_svdag.hpp"
+#include "accel/temporal/laid_out_multi_frame_dag.hpp"
 #include "core/util/error.hpp"
 #include "core/voxel/voxelizer.hpp"
 #include "python/array_helpers.hpp"
 #include "python/bindings.hpp"
 #include "python/loaded_scene.hpp"
-#include "techniques/dag_raycast/animation_dag.hpp"
+#include "accel/temporal/animation_dag.hpp"
 #include "techniques/dag_raycast/dag_raycast_settings.hpp"
 
 namespace gilab::python {
@@ -68,7 +68,7 @@ py::object root_or_none(uint32_t root, uint32_t empty) { return root == empty ? 
 }  // namespace
 
 void register_multi_frame_dag_bindings(py::module_& m) {
-    py::class_<TemporalSvdag>(m, "TemporalSvdag", R"doc(The time-correlated multi-frame DAG laid out in P2's 32-bit format (§2.2, §4):
+    py::class_<LaidOutMultiFrameDag>(m, "LaidOutMultiFrameDag", R"doc(The time-correlated multi-frame DAG laid out in P2's 32-bit format (§2.2, §4):
 per node a word holding the 8-bit child mask, then one 32-bit word address per
 non-empty child. Level 0 holds one root per non-empty frame in time order, so
 frame f starts at root(f); everything below is shared across space and time.
@@ -78,34 +78,38 @@ nodes below, the leaf node included), nodes_per_frame N_p = N_n / F, bytes the
 32-bit storage — the "TC" columns of dag-table5 (MB = bytes / 10⁶).
 Get one from MultiFrameDag.lay_out() or build_animation_dag(...).dag.
 )doc")
-        .def_property_readonly("grid", &TemporalSvdag::grid)
-        .def_property_readonly("depth", &TemporalSvdag::depth, "Octree depth, ceil(log2 resolution).")
-        .def_property_readonly("frame_count", &TemporalSvdag::frame_count)
-        .def("__len__", &TemporalSvdag::frame_count)
-        .def_property_readonly("node_count", [](const TemporalSvdag& d) { return d.node_count(); }, "N_n.")
-        .def_property_readonly("nodes_per_frame", &TemporalSvdag::nodes_per_frame, "N_p = N_n / F.")
-        .def_property_readonly("pointer_count", [](const TemporalSvdag& d) { return d.pointer_count(); })
-        .def_property_readonly("bytes", [](const TemporalSvdag& d) { return d.bytes(); },
+        .def_property_readonly("grid", &LaidOutMultiFrameDag::grid)
+        .def_property_readonly("depth", &LaidOutMultiFrameDag::depth, "Octree depth, ceil(log2 resolution).")
+        .def_property_readonly("frame_count", &LaidOutMultiFrameDag::frame_count)
+        .def("__len__", &LaidOutMultiFrameDag::frame_count)
+        .def_property_readonly("node_count", [](const LaidOutMultiFrameDag& d) { return d.node_count(); }, "N_n.")
+        .def_property_readonly("nodes_per_frame", &LaidOutMultiFrameDag::nodes_per_frame, "N_p = N_n / F.")
+        .def_property_readonly("pointer_count", [](const LaidOutMultiFrameDag& d) { return d.pointer_count(); })
+        .def_property_readonly("bytes", [](const LaidOutMultiFrameDag& d) { return d.bytes(); },
                                "32-bit storage: 4 B per node word and per pointer.")
-        .def_property_readonly("level_node_counts", [](const TemporalSvdag& d) { return d.level_node_counts(); },
+        .def_property_readonly("level_node_counts", [](const LaidOutMultiFrameDag& d) { return d.level_node_counts(); },
                                "Nodes per level, level 0 (the roots, one per non-empty frame) first; depth + 1 entries.")
         .def_property_readonly(
             "words",
             [](const py::object& self) {
-                const TemporalSvdag& d = self.cast<const TemporalSvdag&>();
+                const LaidOutMultiFrameDag& d = self.cast<const LaidOutMultiFrameDag&>();
                 return py::array_t<uint32_t>(py::ssize_t(d.words().size()), d.words().data(), self);
             },
             "The 32-bit words (a view, no copy): canonical, so equal DAGs give equal words however they were built.")
         .def(
-            "root", [](const TemporalSvdag& d, int64_t frame) { return root_or_none(d.root(frame_index(frame)), TemporalSvdag::kEmptyFrame); },
+            "root",
+            [](const LaidOutMultiFrameDag& d, int64_t frame) {
+                return root_or_none(d.root(frame_index(frame)), LaidOutMultiFrameDag::kEmptyFrame);
+            },
             "frame"_a, "Word address of frame's root, or None for a frame without voxels.")
         .def(
             "reachable_node_count",
-            [](const TemporalSvdag& d, int64_t frame) { return d.reachable_node_count(frame_index(frame)); }, "frame"_a,
+            [](const LaidOutMultiFrameDag& d, int64_t frame) { return d.reachable_node_count(frame_index(frame)); },
+            "frame"_a,
             "Nodes below root(frame), root and leaf included: that frame's own SVDAG node count.")
         .def(
             "decode",
-            [](const TemporalSvdag& d, int64_t frame) {
+            [](const LaidOutMultiFrameDag& d, int64_t frame) {
                 const size_t f = frame_index(frame);
                 std::vector<uint64_t> codes;
                 {
@@ -118,7 +122,7 @@ Get one from MultiFrameDag.lay_out() or build_animation_dag(...).dag.
             "frame"_a, "Morton codes of frame's occupied voxels, ascending (uint64): equal to the voxels it was built from.")
         .def(
             "contains_voxel",
-            [](const TemporalSvdag& d, int64_t frame, const py::object& voxel) {
+            [](const LaidOutMultiFrameDag& d, int64_t frame, const py::object& voxel) {
                 auto v = voxel.cast<std::vector<int64_t>>();
                 if (v.size() != 3) throw Error("voxel", "expected 3 integer coordinates");
                 for (int64_t c : v)
@@ -128,7 +132,7 @@ Get one from MultiFrameDag.lay_out() or build_animation_dag(...).dag.
             "frame"_a, "voxel"_a, "Whether voxel (x, y, z) is occupied in frame.")
         .def(
             "occupied",
-            [](const TemporalSvdag& d, int64_t frame, const py::object& points) {
+            [](const LaidOutMultiFrameDag& d, int64_t frame, const py::object& points) {
                 const size_t f = frame_index(frame);
                 d.root(f);  // the frame must exist
                 std::vector<Vec3> p = points_from_array(points, "points");
@@ -144,11 +148,11 @@ Get one from MultiFrameDag.lay_out() or build_animation_dag(...).dag.
                 return to_numpy(std::move(inside), {n}).attr("astype")("bool");
             },
             "frame"_a, "points"_a, "Whether (n, 3) world points lie in voxels occupied in frame: bool array.")
-        .def_property_readonly("stats", [](const TemporalSvdag& d) { return stats_to_dict(d.stats()); },
+        .def_property_readonly("stats", [](const LaidOutMultiFrameDag& d) { return stats_to_dict(d.stats()); },
                                "frames, nodes, nodes_per_frame, pointers, bytes, nodes_level_<k>.")
-        .def("__repr__", [](const TemporalSvdag& d) {
-            return "<gilab.TemporalSvdag " + std::to_string(d.frame_count()) + " frames, " + std::to_string(d.node_count()) +
-                   " nodes>";
+        .def("__repr__", [](const LaidOutMultiFrameDag& d) {
+            return "<gilab.LaidOutMultiFrameDag " + std::to_string(d.frame_count()) + " frames, " +
+                   std::to_string(d.node_count()) + " nodes>";
         });
 
     py::class_<MultiFrameDag>(m, "MultiFrameDag", R"doc(Time-correlated multi-frame SVDAG (P2 §4), the builder: the SVOs of all
@@ -160,7 +164,7 @@ nodes merged bottom-up across space and time, one root per frame.
   dag.update_frame(k, voxels)              # replace frame k; dead nodes are kept
   dag.compact()                            # until compact() drops them
   gilab.MultiFrameDag.merge_all(svdags)    # mode (a): per-frame Svdags at once
-  dag.lay_out()                            # → gilab.TemporalSvdag (32-bit words)
+  dag.lay_out()                            # → gilab.LaidOutMultiFrameDag (32-bit words)
 
 `voxels` is a gilab.VoxelList on the DAG's grid (voxelize(..., grid=dag.grid))
 or an array of uint64 Morton codes, ascending and unique.
@@ -235,16 +239,17 @@ cells_reused, ms}.
                 py::gil_scoped_release release;
                 return d.lay_out();
             },
-            "The 32-bit layout as a gilab.TemporalSvdag (canonical: equal DAGs give equal words).")
+            "The 32-bit layout as a gilab.LaidOutMultiFrameDag (canonical: equal DAGs give equal words).")
         .def("__repr__", [](const MultiFrameDag& d) {
             return "<gilab.MultiFrameDag " + std::to_string(d.frame_count()) + " frames, " + std::to_string(d.node_count()) +
                    " nodes>";
         });
 
-    py::class_<AnimationDag>(m, "AnimationDag", R"doc(What build_animation_dag returns: ``dag`` (a gilab.TemporalSvdag), ``times``
-(scene time of each frame) and ``stats`` (build_ms, voxelize_ms, merge_ms,
-layout_ms, voxels_per_frame, voxel_size, table_bytes, peak_rss_mib; for the
-incremental build also cells_rebuilt and cells_reused).
+    py::class_<AnimationDag>(m, "AnimationDag", R"doc(What build_animation_dag returns: ``dag`` (a
+gilab.LaidOutMultiFrameDag), ``times`` (scene time of each frame) and ``stats``
+(build_ms, voxelize_ms, merge_ms, layout_ms, voxels_per_frame, voxel_size,
+table_bytes, peak_rss_mib; for the incremental build also cells_rebuilt and
+cells_reused).
 )doc")
         .def_readonly("dag", &AnimationDag::dag)
         .def_readonly("times", &AnimationDag::times)

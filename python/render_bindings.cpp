@@ -61,7 +61,7 @@ CameraChoice camera_from(const py::object& camera) {
 RenderOutcome render_scene(const LoadedScene& scene, const RenderRequest& request, const CameraChoice& camera,
                            int threads) {
     ThreadLimit limit(threads);
-    RenderSetup setup = begin_render(request);
+    TechniqueAndRig setup = begin_render(request);
     ViewSet views;
     if (const auto* eye = std::get_if<EyeCamera>(&camera)) {
         views = ViewSet::mono(*eye);

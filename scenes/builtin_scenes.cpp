@@ -3,7 +3,7 @@
 #include <array>
 #include <map>
 #include "scenes/fire_scene.hpp"
-#include "scenes/shadow_scenes.hpp"
+#include "scenes/villa_and_terrain.hpp"
 
 namespace gilab {
 

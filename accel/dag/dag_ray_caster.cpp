@@ -5,7 +5,6 @@
 #include <cmath>
 #include "accel/dag/child_mask.hpp"
 #include "accel/dag/svdag.hpp"
-#include "accel/dag/temporal_svdag.hpp"
 
 namespace gilab {
 namespace {
@@ -31,17 +30,6 @@ DagWordsView dag_view(const Svdag& dag) {
     v.grid = dag.grid();
     v.empty = dag.empty();
     v.root = v.empty ? 0 : dag.root();
-    return v;
-}
-
-DagWordsView dag_view(const TemporalSvdag& dag, size_t frame) {
-    DagWordsView v;
-    v.words = dag.words();
-    v.depth = dag.depth();
-    v.grid = dag.grid();
-    const uint32_t root = dag.root(frame);  // throws for a frame outside the animation
-    v.empty = root == TemporalSvdag::kEmptyFrame;
-    v.root = v.empty ? 0 : root;
     return v;
 }
 

@@ -1,9 +1,9 @@
 #include "accel/dag/voxel_ray_traversal.hpp"
 #include <utility>
+#include "accel/dag/child_mask.hpp"
 #include "accel/dag/esvo.hpp"
 #include "accel/dag/svdag.hpp"
 #include "accel/dag/svo.hpp"
-#include "accel/dag/temporal_svdag.hpp"
 
 namespace gilab {
 namespace {
@@ -18,12 +18,21 @@ struct EsvoAccess {
     uint8_t mask(uint32_t n) const { return s.valid_mask(n); }
     uint32_t child(uint32_t n, int slot) const { return s.child(n, slot); }
 };
-// Svdag and TemporalSvdag share the word format and its accessors.
-template <class Dag>
-struct DagAccess {
-    const Dag& s;
+struct SvdagAccess {
+    const Svdag& s;
     uint8_t mask(uint32_t n) const { return s.mask(n); }
     uint32_t child(uint32_t n, int slot) const { return s.child(n, slot); }
+};
+// The same word format read straight from the words: per node a word with the child
+// mask, then one word address per non-empty child.
+struct WordsAccess {
+    std::span<const uint32_t> words;
+    uint8_t mask(uint32_t n) const { return static_cast<uint8_t>(words[n] & 0xffu); }
+    uint32_t child(uint32_t n, int slot) const {
+        const uint32_t m = words[n] & 0xffu;
+        if (!(m & (1u << slot))) return 0xffffffffu;
+        return words[n + 1 + child_rank(m, slot)];
+    }
 };
 
 template <class Tree>
@@ -106,13 +115,11 @@ VoxelRayHit trace_voxel_ray(const Esvo& esvo, const Ray& ray) {
 }
 
 VoxelRayHit trace_voxel_ray(const Svdag& dag, const Ray& ray) {
-    return traverse(DagAccess<Svdag>{dag}, dag.grid(), dag.depth(), dag.empty(), dag.root(), ray);
+    return traverse(SvdagAccess{dag}, dag.grid(), dag.depth(), dag.empty(), dag.root(), ray);
 }
 
-VoxelRayHit trace_voxel_ray(const TemporalSvdag& dag, size_t frame, const Ray& ray) {
-    const uint32_t root = dag.root(frame);
-    const bool empty = root == TemporalSvdag::kEmptyFrame;
-    return traverse(DagAccess<TemporalSvdag>{dag}, dag.grid(), dag.depth(), empty, root, ray);
+VoxelRayHit trace_voxel_ray(const DagWordsView& dag, const Ray& ray) {
+    return traverse(WordsAccess{dag.words}, dag.grid, dag.depth, dag.empty, dag.root, ray);
 }
 
 }  // namespace gilab

@@ -6,15 +6,16 @@
 // the same tree.
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include "core/util/math.hpp"
 #include "core/util/ray.hpp"
+#include "core/voxel/voxel_grid.hpp"
 
 namespace gilab {
 
 class Svo;
 class Esvo;
 class Svdag;
-class TemporalSvdag;
 
 struct VoxelRayHit {
     bool hit = false;
@@ -26,8 +27,18 @@ struct VoxelRayHit {
 VoxelRayHit trace_voxel_ray(const Svo& svo, const Ray& ray);
 VoxelRayHit trace_voxel_ray(const Esvo& esvo, const Ray& ray);
 VoxelRayHit trace_voxel_ray(const Svdag& dag, const Ray& ray);
-// Through the root of `frame` (an empty frame is never hit). Throws Error for a frame
-// outside the animation.
-VoxelRayHit trace_voxel_ray(const TemporalSvdag& dag, size_t frame, const Ray& ray);
+
+// One DAG in P2's 32-bit word format (an Svdag, or one frame of a laid-out multi-frame
+// DAG, accel/temporal/laid_out_multi_frame_dag.hpp): its words, the word address of the
+// root, and its grid.
+struct DagWordsView {
+    std::span<const uint32_t> words;
+    uint32_t root = 0;
+    int depth = 0;  // levels below the root; the voxels are at level `depth`
+    VoxelGrid grid;
+    bool empty = true;
+};
+// Through the view's root (an empty view is never hit).
+VoxelRayHit trace_voxel_ray(const DagWordsView& dag, const Ray& ray);
 
 }  // namespace gilab

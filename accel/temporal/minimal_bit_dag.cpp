@@ -10,7 +10,7 @@ namespace {
 constexpr const char* kWhat = "minimal-bit DAG";
 }  // namespace
 
-MinimalBitDag encode_minimal_bits(const TemporalSvdag& dag, PointerAddressing addressing) {
+MinimalBitDag encode_minimal_bits(const LaidOutMultiFrameDag& dag, PointerAddressing addressing) {
     MinimalBitDag out;
     out.grid_ = dag.grid();
     out.depth_ = dag.depth();
@@ -72,13 +72,14 @@ MinimalBitDag encode_minimal_bits(const TemporalSvdag& dag, PointerAddressing ad
     out.stream_ = stream.release();
 
     BitWriter roots;
-    for (size_t f = 0; f < dag.frame_count(); ++f) out.root_has_empty_marker_ |= dag.root(f) == TemporalSvdag::kEmptyFrame;
+    for (size_t f = 0; f < dag.frame_count(); ++f)
+        out.root_has_empty_marker_ |= dag.root(f) == LaidOutMultiFrameDag::kEmptyFrame;
     out.root_bits_ = bits_for_count(targets(0) + (out.root_has_empty_marker_ ? 1 : 0));
     for (size_t f = 0; f < dag.frame_count(); ++f) {
         const uint32_t r = dag.root(f);
         uint64_t value = 0;
-        if (r != TemporalSvdag::kEmptyFrame) value = by_offset ? offset[0][index_of[r]] : index_of[r];
-        if (out.root_has_empty_marker_) value = r == TemporalSvdag::kEmptyFrame ? 0 : value + 1;
+        if (r != LaidOutMultiFrameDag::kEmptyFrame) value = by_offset ? offset[0][index_of[r]] : index_of[r];
+        if (out.root_has_empty_marker_) value = r == LaidOutMultiFrameDag::kEmptyFrame ? 0 : value + 1;
         roots.write(value, out.root_bits_);
     }
     out.root_table_ = roots.release();

@@ -15,7 +15,7 @@
 // level (8-byte start offset, 1-byte width).
 #include <cstdint>
 #include <vector>
-#include "accel/dag/temporal_svdag.hpp"
+#include "accel/temporal/laid_out_multi_frame_dag.hpp"
 #include "core/voxel/voxel_grid.hpp"
 
 namespace gilab {
@@ -40,7 +40,7 @@ public:
     std::vector<uint64_t> decode(size_t frame) const;  // Morton codes, ascending
 
 private:
-    friend MinimalBitDag encode_minimal_bits(const TemporalSvdag& dag, PointerAddressing addressing);
+    friend MinimalBitDag encode_minimal_bits(const LaidOutMultiFrameDag& dag, PointerAddressing addressing);
     // Bit offset of every node of `level`, in order, found by parsing the stream.
     std::vector<uint64_t> parse_level(int level) const;
 
@@ -57,6 +57,6 @@ private:
     bool root_has_empty_marker_ = false;
 };
 
-MinimalBitDag encode_minimal_bits(const TemporalSvdag& dag, PointerAddressing addressing);
+MinimalBitDag encode_minimal_bits(const LaidOutMultiFrameDag& dag, PointerAddressing addressing);
 
 }  // namespace gilab

@@ -245,7 +245,7 @@ size_t MultiFrameDag::table_bytes() const {
     return b;
 }
 
-TemporalSvdag MultiFrameDag::lay_out() const {
+LaidOutMultiFrameDag MultiFrameDag::lay_out() const {
     std::vector<uint32_t> present;
     for (uint32_t r : roots_)
         if (r != kEmptyFrame) present.push_back(r);
@@ -254,9 +254,10 @@ TemporalSvdag MultiFrameDag::lay_out() const {
     DagLayout layout = lay_out_dag(tables_, present, options, kWhat);
     std::vector<uint32_t> roots;
     size_t next = 0;
-    for (uint32_t r : roots_) roots.push_back(r == kEmptyFrame ? TemporalSvdag::kEmptyFrame : layout.root_addresses[next++]);
-    return TemporalSvdag(grid_, std::move(layout.words), std::move(layout.level_begin), std::move(layout.level_counts),
-                         std::move(roots), layout.pointer_count);
+    for (uint32_t r : roots_)
+        roots.push_back(r == kEmptyFrame ? LaidOutMultiFrameDag::kEmptyFrame : layout.root_addresses[next++]);
+    return LaidOutMultiFrameDag(grid_, std::move(layout.words), std::move(layout.level_begin),
+                                std::move(layout.level_counts), std::move(roots), layout.pointer_count);
 }
 
 }  // namespace gilab

@@ -23,7 +23,7 @@
 #include "accel/dag/dag_level_table.hpp"
 #include "accel/dag/dag_ref_counts.hpp"
 #include "accel/dag/svdag.hpp"
-#include "accel/dag/temporal_svdag.hpp"
+#include "accel/temporal/laid_out_multi_frame_dag.hpp"
 #include "core/voxel/voxel_grid.hpp"
 
 namespace gilab {
@@ -78,7 +78,7 @@ public:
     const std::vector<uint32_t>& root_ids() const { return roots_; }  // kEmptyFrame for an empty frame
 
     // The 32-bit layout (canonical: equal DAGs give equal words however they were built).
-    TemporalSvdag lay_out() const;
+    LaidOutMultiFrameDag lay_out() const;
 
     static constexpr uint32_t kEmptyFrame = 0xffffffffu;
     // Default split: cells of 32^3 voxels.

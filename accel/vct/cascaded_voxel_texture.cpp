@@ -229,7 +229,7 @@ AnisotropicVoxel CascadedVoxelTexture::read(int level, const IVec3& v) const {
     return voxel;
 }
 
-FragmentVoxelizeStats CascadedVoxelTexture::voxelize(int level, const AnisotropicVoxelizer& voxelizer,
+FragmentVoxelizeStats CascadedVoxelTexture::voxelize(int level, const FragmentVoxelizer& voxelizer,
                                                      const VoxelBox& box) {
     const VoxelBox b = box.intersect(region(level));
     clear_gbuffer(level, b);
@@ -265,7 +265,7 @@ std::vector<VoxelBox> subtract(const VoxelBox& a, const VoxelBox& b) {
     return out;
 }
 
-FragmentVoxelizeStats CascadedVoxelTexture::voxelize_own(int level, const AnisotropicVoxelizer& voxelizer,
+FragmentVoxelizeStats CascadedVoxelTexture::voxelize_own(int level, const FragmentVoxelizer& voxelizer,
                                                          const VoxelBox& box) {
     const VoxelBox inner = inner_box(level);
     own_inner_[size_t(level)] = inner;
@@ -277,7 +277,7 @@ FragmentVoxelizeStats CascadedVoxelTexture::voxelize_own(int level, const Anisot
     return stats;
 }
 
-FragmentVoxelizeStats CascadedVoxelTexture::follow_inner(int level, const AnisotropicVoxelizer& voxelizer,
+FragmentVoxelizeStats CascadedVoxelTexture::follow_inner(int level, const FragmentVoxelizer& voxelizer,
                                                          const std::vector<VoxelBox>& exposed) {
     FragmentVoxelizeStats stats;
     const VoxelBox old_inner = own_inner_[size_t(level)].intersect(region(level));

@@ -16,7 +16,7 @@
 #include <cstdint>
 #include <vector>
 #include "accel/vct/anisotropic_voxel.hpp"
-#include "accel/vct/anisotropic_voxelizer.hpp"
+#include "accel/vct/fragment_voxelizer.hpp"
 #include "core/util/math.hpp"
 
 namespace gilab {
@@ -89,21 +89,21 @@ public:
     void write(int level, const AnisotropicVoxel& voxel);       // must lie in the region
     AnisotropicVoxel read(int level, const IVec3& v) const;     // G-buffer of one voxel
     // Voxelizes box ∩ region of the level into the G-buffer (clearing it first).
-    FragmentVoxelizeStats voxelize(int level, const AnisotropicVoxelizer& voxelizer, const VoxelBox& box);
-    FragmentVoxelizeStats voxelize(int level, const AnisotropicVoxelizer& voxelizer) {
+    FragmentVoxelizeStats voxelize(int level, const FragmentVoxelizer& voxelizer, const VoxelBox& box);
+    FragmentVoxelizeStats voxelize(int level, const FragmentVoxelizer& voxelizer) {
         return voxelize(level, voxelizer, region(level));
     }
     // The cascades proper: a level voxelizes only its own part, box ∩ region minus the
     // inner box the finer level covers (whose radiance is filtered from that level);
     // the inner box's G-buffer is left clear. The inner box used is remembered.
-    FragmentVoxelizeStats voxelize_own(int level, const AnisotropicVoxelizer& voxelizer, const VoxelBox& box);
-    FragmentVoxelizeStats voxelize_own(int level, const AnisotropicVoxelizer& voxelizer) {
+    FragmentVoxelizeStats voxelize_own(int level, const FragmentVoxelizer& voxelizer, const VoxelBox& box);
+    FragmentVoxelizeStats voxelize_own(int level, const FragmentVoxelizer& voxelizer) {
         return voxelize_own(level, voxelizer, region(level));
     }
     // After the finer level moved: voxelizes what left the inner box and clears what
     // entered it, so the level again holds exactly its own part. `exposed` (boxes a
     // scroll just uncovered) are voxelized in the same pass, minus the inner box.
-    FragmentVoxelizeStats follow_inner(int level, const AnisotropicVoxelizer& voxelizer,
+    FragmentVoxelizeStats follow_inner(int level, const FragmentVoxelizer& voxelizer,
                                        const std::vector<VoxelBox>& exposed = {});
     bool occupied(int level, const IVec3& v) const;   // any face with opacity > 0
     size_t occupied_voxels(int level) const;

@@ -45,7 +45,7 @@ DenseMipTexture::DenseMipTexture(const DenseMipConfig& config) : config_(config)
     }
 }
 
-FragmentVoxelizeStats DenseMipTexture::voxelize(const AnisotropicVoxelizer& voxelizer) {
+FragmentVoxelizeStats DenseMipTexture::voxelize(const FragmentVoxelizer& voxelizer) {
     FragmentVoxelizeStats stats;
     voxels = voxelizer.voxelize(lattice(), region(), &stats);
     return stats;

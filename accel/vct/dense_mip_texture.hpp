@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <vector>
 #include "accel/vct/anisotropic_voxel.hpp"
-#include "accel/vct/anisotropic_voxelizer.hpp"
+#include "accel/vct/fragment_voxelizer.hpp"
 #include "core/util/math.hpp"
 
 namespace gilab {
@@ -45,7 +45,7 @@ public:
     }
 
     // Replaces the G-buffer by voxelizing the whole grid.
-    FragmentVoxelizeStats voxelize(const AnisotropicVoxelizer& voxelizer);
+    FragmentVoxelizeStats voxelize(const FragmentVoxelizer& voxelizer);
     // Zeroes level 0 of a buffer, then the caller writes occupied voxels into it.
     static void clear_level0(std::vector<std::vector<Vec4>>& buffer);
     // Levels 1.. of a buffer from level 0.

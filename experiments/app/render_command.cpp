@@ -243,9 +243,9 @@ HeadPose pose_from_camera(const SceneCamera& c) {
     return {eye.position(), eye.orientation()};
 }
 
-RenderSetup begin_render(const RenderRequest& request) {
+TechniqueAndRig begin_render(const RenderRequest& request) {
     check_options(request);
-    RenderSetup setup;
+    TechniqueAndRig setup;
     setup.technique = TechniqueRegistry::builtin().create(request.technique);  // fail fast on a bad name
     setup.settings = read_settings(request);
     if (request.hmd) setup.rig = HmdRig(find_hmd_preset(*request.hmd));  // before loading: bad preset fails fast
@@ -254,7 +254,7 @@ RenderSetup begin_render(const RenderRequest& request) {
     return setup;
 }
 
-ViewSet aim_views(RenderSetup& setup, const RenderRequest& request, const Scene& scene) {
+ViewSet aim_views(TechniqueAndRig& setup, const RenderRequest& request, const Scene& scene) {
     if (std::optional<HmdRig>& rig = setup.rig) {
         if (scene.hmd) rig->set_pose(scene.hmd->pose);
         else rig->set_pose(pose_from_camera(*scene.camera));
@@ -272,7 +272,7 @@ ViewSet aim_views(RenderSetup& setup, const RenderRequest& request, const Scene&
     return ViewSet::mono(EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, w, h));
 }
 
-void prepare_render(RenderSetup& setup, const RenderRequest& request, const Scene& scene) {
+void prepare_render(TechniqueAndRig& setup, const RenderRequest& request, const Scene& scene) {
     Technique& technique = *setup.technique;
     const Settings& settings = setup.settings;
     technique.prepare(scene, settings);
@@ -287,7 +287,7 @@ void prepare_render(RenderSetup& setup, const RenderRequest& request, const Scen
     settings.report_unused();
 }
 
-std::vector<Film> render_films(RenderSetup& setup, const RenderRequest& request, const Scene& scene,
+std::vector<Film> render_films(TechniqueAndRig& setup, const RenderRequest& request, const Scene& scene,
                                const ViewSet& views) {
     Technique& technique = *setup.technique;
     if (request.time != 0) technique.update(request.time);
@@ -299,7 +299,7 @@ std::vector<Film> render_films(RenderSetup& setup, const RenderRequest& request,
 }
 
 std::vector<std::string> run_render(const RenderRequest& request) {
-    RenderSetup setup = begin_render(request);
+    TechniqueAndRig setup = begin_render(request);
     std::optional<TracePlan> plan = plan_trace(request);  // a bad trace fails before the scene loads
 
     OpenedScene opened = open_scene(request.scene, request.assets);

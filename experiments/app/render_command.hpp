@@ -35,24 +35,25 @@ struct RenderRequest {
 };
 
 // The steps of `gilab render` that make the images, in order. The Python module runs the
-// same steps, so both give bit-identical images for the same request.
-struct RenderSetup {
+// same steps, so both give bit-identical images for the same request. They share what the
+// render is made with: the technique, its settings and, for a stereo pair, the HMD rig.
+struct TechniqueAndRig {
     std::unique_ptr<Technique> technique;
     Settings settings;
     std::optional<HmdRig> rig;  // set: a stereo pair
 };
 // Checks the options and creates the technique, its settings and the HMD rig, all before
 // the scene loads, so a bad option never costs a scene load.
-RenderSetup begin_render(const RenderRequest& request);
+TechniqueAndRig begin_render(const RenderRequest& request);
 // The views of the scene: the rig's pair (posed by the scene's HMD or its camera, with
 // the request's ipd and size) or the scene camera at the request's size (512² default).
-ViewSet aim_views(RenderSetup& setup, const RenderRequest& request, const Scene& scene);
+ViewSet aim_views(TechniqueAndRig& setup, const RenderRequest& request, const Scene& scene);
 // Prepares the technique for the scene; settings it never read are errors (and --spp or
 // --time-budget given to a technique that takes none).
-void prepare_render(RenderSetup& setup, const RenderRequest& request, const Scene& scene);
+void prepare_render(TechniqueAndRig& setup, const RenderRequest& request, const Scene& scene);
 // Moves the scene to request.time when it is not 0, renders every view and tags each film
 // with its provenance (scene, view, technique, settings, seed, HMD).
-std::vector<Film> render_films(RenderSetup& setup, const RenderRequest& request, const Scene& scene,
+std::vector<Film> render_films(TechniqueAndRig& setup, const RenderRequest& request, const Scene& scene,
                                const ViewSet& views);
 
 // Renders and writes OUTPUT.exr and OUTPUT.png; returns the paths written. With a head

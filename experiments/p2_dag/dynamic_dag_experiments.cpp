@@ -12,7 +12,7 @@
 #include "accel/temporal/minimal_bit_dag.hpp"
 #include "accel/dag/svdag.hpp"
 #include "accel/dag/svo.hpp"
-#include "accel/dag/temporal_svdag.hpp"
+#include "accel/temporal/laid_out_multi_frame_dag.hpp"
 #include "core/scene/camera.hpp"
 #include "core/util/error.hpp"
 #include "core/util/format.hpp"
@@ -24,7 +24,7 @@
 #include "experiments/runner/experiment.hpp"
 #include "experiments/runner/measures.hpp"
 #include "scenes/scene_library.hpp"
-#include "techniques/dag_raycast/animation_dag.hpp"
+#include "accel/temporal/animation_dag.hpp"
 #include "techniques/technique.hpp"
 
 namespace gilab {
@@ -116,7 +116,7 @@ struct Table5Figures {
     size_t diff_mask_leaf_bytes = 0;
     uint64_t svdag_nodes = 0;           // Σ_f |DAG_f|
     size_t svdag_bytes = 0;
-    TemporalSvdag tc;                   // from the incremental build
+    LaidOutMultiFrameDag tc;            // from the incremental build
     double tc_reachable_per_frame = 0;
     size_t minbits_offset_bytes = 0, minbits_index_bytes = 0;
     std::vector<BuildFigures> builds;

@@ -13,7 +13,7 @@
 #include <tuple>
 #include <limits>
 #include <tbb/parallel_sort.h>
-#include "accel/vct/anisotropic_voxelizer.hpp"
+#include "accel/vct/fragment_voxelizer.hpp"
 #include "accel/vct/cascaded_voxel_texture.hpp"
 #include "accel/peers/octomap_tree.hpp"
 #include "accel/peers/openvdb_grid.hpp"
@@ -105,7 +105,7 @@ struct StructureFigures {
     // The time from each voxelizer, so structures compare under one voxelizer; NaN where
     // a structure cannot be built from that voxelizer's output.
     double ms_overlap = std::numeric_limits<double>::quiet_NaN();   // core/voxel/voxelizer (triangle/box overlap)
-    double ms_fragment = std::numeric_limits<double>::quiet_NaN();  // anisotropic fragment voxelizer
+    double ms_fragment = std::numeric_limits<double>::quiet_NaN();  // fragment voxelizer (accel/vct/fragment_voxelizer)
 };
 struct SceneFigures {
     std::string scene;
@@ -182,7 +182,7 @@ SceneFigures measure_structures(const ExperimentContext& ctx, const Scene& scene
 
     // Dense 3D texture: fragment voxelization of the whole grid written into one byte of
     // opacity per voxel (the isotropic texture the paper counts).
-    const AnisotropicVoxelizer fragments(frame, scene.materials);
+    const FragmentVoxelizer fragments(frame, scene.materials);
     std::vector<uint8_t> texture;
     double dense_occupied = 0;
     for (int r = 0; r < repeats; ++r) {
@@ -292,20 +292,24 @@ SceneFigures measure_structures(const ExperimentContext& ctx, const Scene& scene
 using RunKey = std::tuple<bool, std::string, uint64_t, int>;
 RunKey run_key(const ExperimentContext& ctx) { return {ctx.quick, ctx.assets.describe(), ctx.seed, ctx.threads}; }
 
+// The paper's two sets of scenes for Tables 1–6: the Stanford models in the Cornell box
+// (Tables 1, 3, 5, its static scenes) and Sponza and Sibenik (Tables 2, 4, 6, its dynamic
+// scenes, static here).
+enum class SceneSet { StanfordModelsInCornellBox, SponzaAndSibenik };
+
 // Results are kept for the process, so Tables 1, 3 and 5 (and 2, 4, 6) share one run.
-const std::vector<SceneFigures>& structure_figures(const ExperimentContext& ctx, bool dynamic_scenes,
-                                                   ExperimentOutput& out) {
-    using Key = std::pair<bool, RunKey>;
+const std::vector<SceneFigures>& structure_figures(const ExperimentContext& ctx, SceneSet set, ExperimentOutput& out) {
+    using Key = std::pair<SceneSet, RunKey>;
     static std::map<Key, std::vector<SceneFigures>> cache;
     static std::map<Key, std::vector<std::string>> cached_notes;
-    const Key key{dynamic_scenes, run_key(ctx)};
+    const Key key{set, run_key(ctx)};
     auto it = cache.find(key);
     if (it == cache.end()) {
         std::vector<SceneFigures> figures;
         ExperimentOutput scratch;
         std::vector<std::pair<std::string, bool>> scenes;  // (name, inside the Cornell box)
         std::vector<int> resolutions;
-        if (dynamic_scenes) {
+        if (set == SceneSet::SponzaAndSibenik) {
             scenes = {{"sponza", false}, {"sibenik", false}};
             resolutions = ctx.quick ? std::vector<int>{128, 256} : std::vector<int>{256, 512};
         } else {
@@ -378,7 +382,9 @@ std::string model_of(const std::string& scene_name) {
     return plus == std::string::npos ? scene_name : scene_name.substr(plus + 1);
 }
 
-enum class Figure { Count, Time, Memory };
+// What a structure table reports: voxel counts (Tables 1–2), voxelization times (3–4) or
+// memory (5–6).
+enum class StructureQuantity { VoxelCount, VoxelizationTime, Memory };
 
 // The paper's memory accounting applied to every structure alike: opacity only, 1 byte
 // per voxel face, 6 faces per node or cell. It puts all structures on the paper's footing
@@ -392,25 +398,30 @@ const char* fixed_by_construction(const std::string& structure) {
     return structure == "3D texture" ? "yes: resolution³" : structure == "cascaded" ? "yes: levels × 32³" : "no";
 }
 
-ExperimentOutput structure_table(const ExperimentContext& ctx, bool dynamic_scenes, Figure figure) {
+ExperimentOutput structure_table(const ExperimentContext& ctx, SceneSet set, StructureQuantity quantity) {
     ExperimentOutput out;
-    const auto& figures = structure_figures(ctx, dynamic_scenes, out);
-    const PaperTable& paper = dynamic_scenes ? paper_dynamic() : paper_static();
-    const int table = (figure == Figure::Count ? 1 : figure == Figure::Time ? 3 : 5) + (dynamic_scenes ? 1 : 0);
+    const bool sponza_and_sibenik = set == SceneSet::SponzaAndSibenik;
+    const auto& figures = structure_figures(ctx, set, out);
+    const PaperTable& paper = sponza_and_sibenik ? paper_dynamic() : paper_static();
+    // The Stanford models' table is 1, 3 or 5; Sponza and Sibenik's is the next one.
+    const int models_table = quantity == StructureQuantity::VoxelCount         ? 1
+                             : quantity == StructureQuantity::VoxelizationTime ? 3
+                                                                               : 5;
+    const int table = models_table + (sponza_and_sibenik ? 1 : 0);
     ResultTable t;
     const char* what[] = {"voxel counts (×10⁶)", "voxelization time (ms)", "memory (MB = 10⁶ B, each structure's real encoding)"};
-    t.title = "Table " + std::to_string(table) + " — " + what[int(figure)] + ", " +
-              (dynamic_scenes ? "Sponza and Sibenik" : "Cornell box + Stanford models");
-    switch (figure) {
-        case Figure::Count:
+    t.title = "Table " + std::to_string(table) + " — " + what[int(quantity)] + ", " +
+              (sponza_and_sibenik ? "Sponza and Sibenik" : "Cornell box + Stanford models");
+    switch (quantity) {
+        case StructureQuantity::VoxelCount:
             t.columns = {"scene", "resolution", "structure", "voxels_millions", "occupied_millions", "paper voxels_millions",
                          "fixed by construction"};
             break;
-        case Figure::Time:
+        case StructureQuantity::VoxelizationTime:
             t.columns = {"scene", "resolution", "structure", "voxelize_ms (overlap voxelizer)",
                          "voxelize_ms (fragment voxelizer)", "paper voxelize_ms"};
             break;
-        case Figure::Memory:
+        case StructureQuantity::Memory:
             t.columns = {"scene", "resolution", "structure", "encoding", "nodes or cells (×10⁶)", "bytes per node or cell",
                          "memory (MB, real encoding)", kPaperAccountingColumn, "all arrays held (MB)",
                          "paper memory (MiB, printed as MB)",
@@ -421,7 +432,7 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, bool dynamic_scen
         const std::string model = model_of(sf.scene);
         // The paper's resolution pair: 128/256 (static), 256/512 (Sponza); quick runs use
         // half those and are compared with the paper's first column only when they match.
-        const int paper_first = dynamic_scenes ? 256 : 128;
+        const int paper_first = sponza_and_sibenik ? 256 : 128;
         int column = sf.resolution == paper_first ? 0 : sf.resolution == 2 * paper_first ? 1 : -1;
         for (const std::string& s : kStructures) {
             const StructureFigures& f = sf.by_structure.at(s);
@@ -429,19 +440,19 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, bool dynamic_scen
             std::optional<PaperCell> p;
             if (column >= 0 && paper.count(model) && paper.at(model).count(s))
                 p = paper.at(model).at(s)[size_t(column)];
-            switch (figure) {
-                case Figure::Count:
+            switch (quantity) {
+                case StructureQuantity::VoxelCount:
                     r["voxels_millions"] = f.voxels / 1e6;
                     r["occupied_millions"] = f.occupied / 1e6;
                     r["paper voxels_millions"] = p ? nlohmann::json(p->voxels_m) : nlohmann::json();
                     r["fixed by construction"] = fixed_by_construction(s);
                     break;
-                case Figure::Time:
+                case StructureQuantity::VoxelizationTime:
                     r["voxelize_ms (overlap voxelizer)"] = std::isnan(f.ms_overlap) ? nlohmann::json() : nlohmann::json(f.ms_overlap);
                     r["voxelize_ms (fragment voxelizer)"] = std::isnan(f.ms_fragment) ? nlohmann::json() : nlohmann::json(f.ms_fragment);
                     r["paper voxelize_ms"] = p ? nlohmann::json(p->ms) : nlohmann::json();
                     break;
-                case Figure::Memory:
+                case StructureQuantity::Memory:
                     r["encoding"] = encodings().at(s);
                     r["nodes or cells (×10⁶)"] = f.voxels / 1e6;
                     r["bytes per node or cell"] = f.encoded_bytes / f.voxels;
@@ -458,12 +469,12 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, bool dynamic_scen
         }
     }
     out.tables.push_back(t);
-    if (figure == Figure::Time) {
+    if (quantity == StructureQuantity::VoxelizationTime) {
         ResultTable ratio;
         ratio.title = "Speed-up of the cascaded voxelization over the dense 3D texture (same run)";
         ratio.columns = {"scene", "resolution", "dense_over_cascaded", "paper dense_over_cascaded"};
         for (const SceneFigures& sf : figures) {
-            const int paper_first = dynamic_scenes ? 256 : 128;
+            const int paper_first = sponza_and_sibenik ? 256 : 128;
             int column = sf.resolution == paper_first ? 0 : sf.resolution == 2 * paper_first ? 1 : -1;
             const std::string model = model_of(sf.scene);
             nlohmann::json pr;
@@ -476,7 +487,7 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, bool dynamic_scen
         }
         out.tables.push_back(ratio);
     }
-    out.config = {{"resolutions", dynamic_scenes ? (ctx.quick ? "128³, 256³" : "256³, 512³") : (ctx.quick ? "64³, 128³" : "128³, 256³")},
+    out.config = {{"resolutions", sponza_and_sibenik ? (ctx.quick ? "128³, 256³" : "256³, 512³") : (ctx.quick ? "64³, 128³" : "128³, 256³")},
                   {"cascade", "32³ per level, levels = log2(resolution/32) + 1, finest voxel = grid voxel, centred on the scene camera if it is inside the scene, else on the scene's centre"},
                   {"repeats", ctx.quick ? 1 : 3},
                   {"statistic", "median"}};
@@ -501,14 +512,14 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, bool dynamic_scen
         "(the paper counts 1 B per face: 6 B per cell). 'all arrays held' adds, for the cascades, every G-buffer "
         "attribute and both radiance buffers. The paper's MB are 2²⁰ B (its 3D texture at 128³, 2 097 152 B, is "
         "printed as 2 MB), ours 10⁶ B; its bytes per node are implied by dividing its memory by its own count.");
-    if (figure == Figure::Memory)
+    if (quantity == StructureQuantity::Memory)
         out.notes.push_back(
             std::string("'") + kPaperAccountingColumn + "': the paper's stated accounting (opacity only, 1 byte per "
             "voxel per face) applied to every structure alike, 6 B per node or cell as counted in column 'nodes or "
             "cells'. The paper's own figures do not all follow it: its cascades do (0.56 MiB ≈ 3 × 32³ × 6 B), its 3D "
             "texture charges 1 B per cell (2 MiB at 128³), and its sparse structures imply other figures per node "
             "(column 'paper bytes per node or cell').");
-    if (dynamic_scenes)
+    if (sponza_and_sibenik)
         out.notes.push_back("Sponza is Dabrovic's 2002 original (66 454 triangles; the paper's is Meinl's 262 k-triangle "
                             "re-model) and Sibenik Dabrovic's cathedral (75 284 triangles), both static here; the paper's "
                             "were animated. The paper's Table 4 heads its Sibenik columns 128³ / 256³ while Tables 2 and "
@@ -523,7 +534,9 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, bool dynamic_scen
 // ---------------------------------------------------------------------------------
 // Rendering experiments on Sponza.
 
-struct RenderSetup {
+// Sponza as the rendering experiments render it: the scene, its camera, the image size and
+// the dense texture's resolution.
+struct SponzaSetup {
     Scene scene;
     EyeCamera camera;
     int size = 0;
@@ -532,8 +545,8 @@ struct RenderSetup {
 
 // Sponza with the scene camera; the stone is made slightly glossy so the specular cone
 // has something to do (the scene file has one diffuse material).
-RenderSetup sponza_setup(const ExperimentContext& ctx, bool glossy) {
-    RenderSetup s;
+SponzaSetup sponza_setup(const ExperimentContext& ctx, bool glossy) {
+    SponzaSetup s;
     s.scene = open_scene("sponza", ctx.assets).scene;
     if (glossy)
         for (Material& m : s.scene.materials) {
@@ -561,7 +574,7 @@ std::unique_ptr<Technique> make_vct(const Scene& scene, nlohmann::json settings,
 void quick_note(const ExperimentContext& ctx, ExperimentOutput& out) {
     if (ctx.quick)
         out.notes.push_back("Quick run: dense_resolution 64 (the finest voxel of both structures is 1/64 of the scene), "
-                            "48² images (32² along camera paths), 8 voxel-bounce cones instead of 16, fewer frames; "
+                            "48² images (32² along the camera walks), 8 voxel-bounce cones instead of 16, fewer frames; "
                             "at this size the dense texture is small, so memory and time ratios favour it.");
 }
 
@@ -578,22 +591,22 @@ void save_images(const ExperimentContext& ctx, ExperimentOutput& out, const std:
     out.files.push_back(name + ".png");
 }
 
-// The walks of Figs. 9–10, straight down each scene's nave, looking ahead and slightly
-// up. The paper walks through both of its dynamic scenes.
-struct Walk {
+// The camera walks of Figs. 9–10, straight down each scene's nave, looking ahead and
+// slightly up. The paper walks through both of its dynamic scenes.
+struct CameraWalk {
     std::string scene;
     Vec3 from, to, look;  // eye from → to, looking along `look`
     const char* description;
 };
-const std::vector<Walk>& walks() {
-    static const std::vector<Walk> w = {
+const std::vector<CameraWalk>& camera_walks() {
+    static const std::vector<CameraWalk> w = {
         {"sponza", {-10.0f, 2.0f, 0.3f}, {8.0f, 2.0f, 0.3f}, {6.0f, 1.2f, 0.0f}, "eye from (−10, 2, 0.3) to (8, 2, 0.3), looking +x"},
         {"sibenik", {14.0f, -10.5f, 0.0f}, {-6.0f, -10.5f, 0.0f}, {-6.0f, 0.8f, 0.0f},
          "eye from (14, −10.5, 0) to (−6, −10.5, 0), 2 m above the nave floor, looking −x towards the apse"}};
     return w;
 }
 
-std::vector<EyeCamera> walk_cameras(const Walk& walk, int size, int frames) {
+std::vector<EyeCamera> walk_cameras(const CameraWalk& walk, int size, int frames) {
     std::vector<EyeCamera> cams;
     for (int i = 0; i < frames; ++i) {
         const float t = frames > 1 ? float(i) / float(frames - 1) : 0.0f;
@@ -603,7 +616,9 @@ std::vector<EyeCamera> walk_cameras(const Walk& walk, int size, int frames) {
     return cams;
 }
 
-std::vector<EyeCamera> sponza_path(const RenderSetup& s, int frames) { return walk_cameras(walks().at(0), s.size, frames); }
+std::vector<EyeCamera> sponza_walk_cameras(const SponzaSetup& s, int frames) {
+    return walk_cameras(camera_walks().at(0), s.size, frames);
+}
 
 const char* kPhases[] = {"primary_ms", "update_ms", "injection_ms", "direct_ms", "diffuse_ms", "specular_ms", "total_ms"};
 
@@ -611,7 +626,7 @@ const char* kPhases[] = {"primary_ms", "update_ms", "injection_ms", "direct_ms",
 ExperimentOutput run_table7(const ExperimentContext& ctx) {
     ExperimentOutput out;
     quick_note(ctx, out);
-    RenderSetup s = sponza_setup(ctx, true);
+    SponzaSetup s = sponza_setup(ctx, true);
     const int frames = ctx.quick ? 2 : 5;
     struct Variant {
         std::string name;
@@ -635,7 +650,7 @@ ExperimentOutput run_table7(const ExperimentContext& ctx) {
         }
     // The update matters when the viewer moves: timed on the walk down the nave, where the
     // cascades scroll (a fixed camera would leave them nothing to do).
-    const std::vector<EyeCamera> walk = sponza_path(s, ctx.quick ? 3 : 12);
+    const std::vector<EyeCamera> walk = sponza_walk_cameras(s, ctx.quick ? 3 : 12);
     std::vector<std::vector<double>> walk_update(variants.size());
     for (size_t v = 0; v < variants.size(); ++v) {
         auto moving = make_vct(s.scene, variants[v].settings, ctx);
@@ -692,30 +707,32 @@ const nlohmann::json& walk_photon_settings() {
     return s;
 }
 
-struct PathRun {
+// One variant rendered along one camera walk: its figures frame by frame.
+struct CameraWalkRun {
     std::string name;
     std::vector<double> total_ms, update_ms, injection_ms, bytes, rss;
 };
 
-struct WalkRuns {
+// Every variant along one scene's camera walk.
+struct CameraWalkRuns {
     std::string scene;
-    const Walk* walk = nullptr;
-    std::vector<PathRun> runs;  // dense mip, cascaded everything, cascaded strategy, photon
+    const CameraWalk* walk = nullptr;
+    std::vector<CameraWalkRun> runs;  // dense mip, cascaded everything, cascaded strategy, photon
 };
 
 // One walk per scene, shared by Figs. 9 and 10; scenes whose mesh is missing are skipped
 // with a note.
-const std::vector<WalkRuns>& path_runs(const ExperimentContext& ctx, ExperimentOutput& out) {
-    static std::map<RunKey, std::pair<std::vector<WalkRuns>, std::vector<std::string>>> cache;
+const std::vector<CameraWalkRuns>& camera_walk_runs(const ExperimentContext& ctx, ExperimentOutput& out) {
+    static std::map<RunKey, std::pair<std::vector<CameraWalkRuns>, std::vector<std::string>>> cache;
     const RunKey key = run_key(ctx);
     auto it = cache.find(key);
     if (it == cache.end()) {
-        std::vector<WalkRuns> all;
+        std::vector<CameraWalkRuns> all;
         ExperimentOutput scratch;
-        for (const Walk& walk : walks()) {
+        for (const CameraWalk& walk : camera_walks()) {
             std::optional<Scene> scene = try_scene(ctx, walk.scene, scratch, false);
             if (!scene) continue;
-            WalkRuns w;
+            CameraWalkRuns w;
             w.scene = walk.scene;
             w.walk = &walk;
             const int size = ctx.quick ? 32 : 192, dense_resolution = ctx.quick ? 64 : 128;
@@ -725,7 +742,7 @@ const std::vector<WalkRuns>& path_runs(const ExperimentContext& ctx, ExperimentO
                 {"cascaded, update everything", {{"dense_resolution", dense_resolution}, {"update", "everything"}}},
                 {"cascaded, update strategy", {{"dense_resolution", dense_resolution}, {"update", "strategy"}}}};
             for (const auto& [name, settings] : variants) {
-                PathRun run;
+                CameraWalkRun run;
                 run.name = name;
                 auto t = make_vct(*scene, settings, ctx);
                 for (const EyeCamera& cam : cams) {
@@ -742,7 +759,7 @@ const std::vector<WalkRuns>& path_runs(const ExperimentContext& ctx, ExperimentO
             {
                 // The photon map is traced and built at prepare; the cone-traced variants
                 // inject light every frame, so each photon frame is charged that pass too.
-                PathRun run;
+                CameraWalkRun run;
                 run.name = "photon mapping";
                 auto t = TechniqueRegistry::builtin().create("photon");
                 nlohmann::json settings = walk_photon_settings();
@@ -763,7 +780,7 @@ const std::vector<WalkRuns>& path_runs(const ExperimentContext& ctx, ExperimentO
                 }
                 w.runs.push_back(std::move(run));
             }
-            for (const PathRun& r : w.runs)
+            for (const CameraWalkRun& r : w.runs)
                 ctx.say(walk.scene + ", " + r.name + ": mean frame " + std::to_string(mean(r.total_ms)) + " ms");
             all.push_back(std::move(w));
         }
@@ -781,22 +798,22 @@ std::vector<double> after_first(const std::vector<double>& v) {
 ExperimentOutput run_fig9(const ExperimentContext& ctx) {
     ExperimentOutput out;
     quick_note(ctx, out);
-    const auto& walk_runs = path_runs(ctx, out);
+    const auto& walk_runs = camera_walk_runs(ctx, out);
     ResultTable summary;
     summary.title = "Fig. 9 summary — mean over each walk (first frame excluded: every variant starts from a full build)";
     summary.columns = {"scene", "variant", "frame_ms", "update_ms", "injection_ms", "fps", "paper"};
-    for (const WalkRuns& w : walk_runs) {
+    for (const CameraWalkRuns& w : walk_runs) {
         const auto& runs = w.runs;
         ResultTable t;
         t.title = "Fig. 9 — frame time along a walk through " + w.scene;
         t.columns = {"frame"};
-        for (const PathRun& r : runs) {
+        for (const CameraWalkRun& r : runs) {
             t.columns.push_back(r.name + " ms");
             t.columns.push_back(r.name + " fps");
         }
         for (size_t f = 0; f < runs[0].total_ms.size(); ++f) {
             nlohmann::json row = {{"frame", f + 1}};
-            for (const PathRun& r : runs) {
+            for (const CameraWalkRun& r : runs) {
                 row[r.name + " ms"] = r.total_ms[f];
                 row[r.name + " fps"] = 1000.0 / r.total_ms[f];
             }
@@ -804,13 +821,13 @@ ExperimentOutput run_fig9(const ExperimentContext& ctx) {
         }
         out.tables.push_back(t);
         Plot plot{"Fig. 9 — frame time along the walk through " + w.scene, "frame", "frame time (ms, log scale)", false, true, {}};
-        for (const PathRun& r : runs) {
+        for (const CameraWalkRun& r : runs) {
             PlotSeries series{r.name, {}, r.total_ms, false, true, -1};
             for (size_t f = 0; f < r.total_ms.size(); ++f) series.x.push_back(double(f + 1));
             plot.series.push_back(std::move(series));
         }
         out.plots.push_back({"fig9_" + w.scene, std::move(plot)});
-        for (const PathRun& r : runs) {
+        for (const CameraWalkRun& r : runs) {
             const double ms = mean(after_first(r.total_ms));
             const char* paper = r.name == "dense mip"                   ? "VXGI ≈ 10 fps below cascaded + strategy"
                                 : r.name == "cascaded, update strategy" ? "fastest; update ≈ 2.0 ms vs VXGI 15.5 ms"
@@ -830,9 +847,9 @@ ExperimentOutput run_fig9(const ExperimentContext& ctx) {
                                 {"fps", nullptr}, {"paper", "15.5 / 2.0 = 7.8 (VXGI vs cascaded)"}});
     }
     out.tables.push_back(summary);
-    nlohmann::json paths = nlohmann::json::object();
-    for (const WalkRuns& w : walk_runs) paths[w.scene] = w.walk->description;
-    out.config = {{"scenes", paths},
+    nlohmann::json walks = nlohmann::json::object();
+    for (const CameraWalkRuns& w : walk_runs) walks[w.scene] = w.walk->description;
+    out.config = {{"scenes", walks},
                   {"frames", walk_runs[0].runs[0].total_ms.size()},
                   {"image", ctx.quick ? "32²" : "192²"},
                   {"photon", walk_photon_settings()}};
@@ -848,27 +865,27 @@ ExperimentOutput run_fig9(const ExperimentContext& ctx) {
 ExperimentOutput run_fig10(const ExperimentContext& ctx) {
     ExperimentOutput out;
     quick_note(ctx, out);
-    const auto& walk_runs = path_runs(ctx, out);
+    const auto& walk_runs = camera_walk_runs(ctx, out);
     ResultTable summary;
     summary.title = "Fig. 10 summary — mean structure memory over each walk, each variant ÷ dense";
     summary.columns = {"scene", "variant", "mean structure (MB)", "over_dense", "paper over_dense"};
-    for (const WalkRuns& w : walk_runs) {
+    for (const CameraWalkRuns& w : walk_runs) {
         const auto& runs = w.runs;
         ResultTable t;
         t.title = "Fig. 10 — memory along the walk through " + w.scene + " (MB = 10⁶ B, of each structure; process RSS)";
         t.columns = {"frame"};
-        for (const PathRun& r : runs) t.columns.push_back(r.name + " (MB)");
+        for (const CameraWalkRun& r : runs) t.columns.push_back(r.name + " (MB)");
         t.columns.push_back("process RSS (MB)");
         for (size_t f = 0; f < runs[0].bytes.size(); ++f) {
             nlohmann::json row = {{"frame", f + 1}};
-            for (const PathRun& r : runs) row[r.name + " (MB)"] = mb(r.bytes[f]);
+            for (const CameraWalkRun& r : runs) row[r.name + " (MB)"] = mb(r.bytes[f]);
             row["process RSS (MB)"] = mb(runs.back().rss[f]);
             t.rows.push_back(row);
         }
         out.tables.push_back(t);
         Plot plot{"Fig. 10 — structure memory along the walk through " + w.scene, "frame", "memory (MB = 10⁶ B, log scale)",
                   false, true, {}};
-        for (const PathRun& r : runs) {
+        for (const CameraWalkRun& r : runs) {
             PlotSeries series{r.name, {}, {}, false, true, -1};
             for (size_t f = 0; f < r.bytes.size(); ++f) {
                 series.x.push_back(double(f + 1));
@@ -877,7 +894,7 @@ ExperimentOutput run_fig10(const ExperimentContext& ctx) {
             plot.series.push_back(std::move(series));
         }
         out.plots.push_back({"fig10_" + w.scene, std::move(plot)});
-        for (const PathRun& r : runs)
+        for (const CameraWalkRun& r : runs)
             summary.rows.push_back({{"scene", w.scene},
                                     {"variant", r.name},
                                     {"mean structure (MB)", mb(mean(r.bytes))},
@@ -898,7 +915,7 @@ ExperimentOutput run_fig10(const ExperimentContext& ctx) {
 ExperimentOutput run_fig11(const ExperimentContext& ctx) {
     ExperimentOutput out;
     quick_note(ctx, out);
-    RenderSetup s = sponza_setup(ctx, false);
+    SponzaSetup s = sponza_setup(ctx, false);
     const int spp = ctx.quick ? 32 : 512;
     // The shared, cached reference: its own seed, so it shares no samples with the run.
     Film reference = path_reference(ctx, s.scene, s.camera, spp, out.files);
@@ -931,7 +948,7 @@ ExperimentOutput run_fig11(const ExperimentContext& ctx) {
 ExperimentOutput run_fig12_13(const ExperimentContext& ctx) {
     ExperimentOutput out;
     quick_note(ctx, out);
-    RenderSetup s = sponza_setup(ctx, false);
+    SponzaSetup s = sponza_setup(ctx, false);
     ResultTable t;
     t.title = "Figs. 12/13 — diffuse (Sponza) and specular (Cornell box + glossy Buddha) cones on and off";
     t.columns = {"image", "mean_color", "mean_indirect", "mean_specular", "frame_ms"};
@@ -1009,7 +1026,7 @@ ExperimentOutput run_stability(const ExperimentContext& ctx) {
     ExperimentOutput out;
     quick_note(ctx, out);
     // (a) Flicker: relative frame-to-frame change of each layer along a slow walk.
-    RenderSetup s = sponza_setup(ctx, false);
+    SponzaSetup s = sponza_setup(ctx, false);
     const int frames = ctx.quick ? 3 : 16;
     if (ctx.quick) s.size = 32;
     std::vector<EyeCamera> cams;
@@ -1092,17 +1109,17 @@ ExperimentOutput run_stability(const ExperimentContext& ctx) {
 
 void register_vct_experiments(ExperimentRegistry& registry) {
     registry.add({"vct-table1", "P3", "voxel counts: 3D texture, SVO, MSVO (OctoMap), SVDAG, OpenVDB, cascaded — Cornell + Stanford models",
-                  [](const ExperimentContext& ctx) { return structure_table(ctx, false, Figure::Count); }});
+                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::StanfordModelsInCornellBox, StructureQuantity::VoxelCount); }});
     registry.add({"vct-table2", "P3", "voxel counts on Sponza and Sibenik (256³/512³)",
-                  [](const ExperimentContext& ctx) { return structure_table(ctx, true, Figure::Count); }});
+                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::SponzaAndSibenik, StructureQuantity::VoxelCount); }});
     registry.add({"vct-table3", "P3", "voxelization time by structure — Cornell + Stanford models",
-                  [](const ExperimentContext& ctx) { return structure_table(ctx, false, Figure::Time); }});
+                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::StanfordModelsInCornellBox, StructureQuantity::VoxelizationTime); }});
     registry.add({"vct-table4", "P3", "voxelization time by structure — Sponza and Sibenik",
-                  [](const ExperimentContext& ctx) { return structure_table(ctx, true, Figure::Time); }});
+                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::SponzaAndSibenik, StructureQuantity::VoxelizationTime); }});
     registry.add({"vct-table5", "P3", "memory, each structure in its real encoding, with the paper's implied bytes per node — Cornell + Stanford models",
-                  [](const ExperimentContext& ctx) { return structure_table(ctx, false, Figure::Memory); }});
+                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::StanfordModelsInCornellBox, StructureQuantity::Memory); }});
     registry.add({"vct-table6", "P3", "memory, each structure in its real encoding — Sponza and Sibenik",
-                  [](const ExperimentContext& ctx) { return structure_table(ctx, true, Figure::Memory); }});
+                  [](const ExperimentContext& ctx) { return structure_table(ctx, SceneSet::SponzaAndSibenik, StructureQuantity::Memory); }});
     registry.add({"vct-table7", "P3", "per-frame phase times, dense mip VCT vs cascaded (Sponza)", run_table7});
     registry.add({"vct-fig9", "P3", "frame time along walks through Sponza and Sibenik: dense, cascaded without/with the update strategy, photon mapping", run_fig9});
     registry.add({"vct-fig10", "P3", "structure memory along the walks through Sponza and Sibenik", run_fig10});

@@ -17,10 +17,6 @@ DagShadowSource parse_shadows(const std::string& s) {
 
 }  // namespace
 
-const char* to_string(DagBuildMode mode) {
-    return mode == DagBuildMode::Incremental ? "incremental" : "all_at_once";
-}
-
 const char* to_string(DagShadowSource source) {
     switch (source) {
         case DagShadowSource::Auto: return "auto";

@@ -2,13 +2,11 @@
 // Settings of the dag_raycast technique: DagRaycastSettings::schema() declares every key
 // with its default, range and description (`gilab list settings dag_raycast`).
 #include <cstdint>
+#include "accel/temporal/animation_dag.hpp"
 #include "core/util/settings.hpp"
 #include "core/util/settings_schema.hpp"
 
 namespace gilab {
-
-enum class DagBuildMode { Incremental, AllAtOnce };
-const char* to_string(DagBuildMode mode);
 
 // Where a lit surface's visibility comes from.
 enum class DagShadowSource {

@@ -99,7 +99,7 @@ void DagRaycastTechnique::prepare(const Scene& scene, const Settings& settings) 
     animation_ = build_animation_dag(scene, options);
     frame_ = 0;
 
-    const TemporalSvdag& dag = animation_.dag;
+    const LaidOutMultiFrameDag& dag = animation_.dag;
     stats_ = animation_.stats;
     stats_.set("frames", double(dag.frame_count()));
     stats_.set("fps", fps_);
@@ -161,7 +161,7 @@ void DagRaycastTechnique::update(double time) {
 void DagRaycastTechnique::render(const ViewSet& views, std::vector<Film>& films) {
     if (!prepared()) throw Error(kName, "render() called before prepare()");
     Stopwatch total;
-    const TemporalSvdag& dag = animation_.dag;
+    const LaidOutMultiFrameDag& dag = animation_.dag;
     const size_t frame = frame_;
     const DagWordsView frame_dag = dag_view(dag, frame);
     const PunctualLight* shading_light = light();

@@ -18,7 +18,7 @@
 #include <vector>
 #include "accel/shadow/light_shadow_dags.hpp"
 #include "core/scene/light.hpp"
-#include "techniques/dag_raycast/animation_dag.hpp"
+#include "accel/temporal/animation_dag.hpp"
 #include "techniques/dag_raycast/dag_raycast_settings.hpp"
 #include "techniques/technique.hpp"
 
@@ -34,7 +34,7 @@ public:
     void render(const ViewSet& views, std::vector<Film>& films) override;
     Stats stats() const override;
 
-    const TemporalSvdag& dag() const { return animation_.dag; }
+    const LaidOutMultiFrameDag& dag() const { return animation_.dag; }
     size_t frame() const { return frame_; }
     size_t frame_count() const { return animation_.times.size(); }
     double fps() const { return fps_; }

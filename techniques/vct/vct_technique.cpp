@@ -270,7 +270,7 @@ void VctTechnique::prepare(const Scene& scene, const Settings& settings) {
     stats_ = Stats();
 
     std::vector<bool> include = static_meshes(scene, scene_.frame());
-    voxelizer_ = AnisotropicVoxelizer(scene_.frame(), scene_.materials(), include);
+    voxelizer_ = FragmentVoxelizer(scene_.frame(), scene_.materials(), include);
     Bounds3 bounds = voxelizer_.triangle_count() > 0 ? voxelizer_.bounds() : scene_.frame().bounds;
     const VoxelGrid grid = VoxelGrid::enclosing(bounds, uint32_t(settings_.dense_resolution));
     const double w0 = settings_.voxel_size > 0 ? settings_.voxel_size : grid.voxel_size();

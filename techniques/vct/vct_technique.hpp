@@ -33,7 +33,7 @@
 #include <optional>
 #include <string>
 #include <vector>
-#include "accel/vct/anisotropic_voxelizer.hpp"
+#include "accel/vct/fragment_voxelizer.hpp"
 #include "accel/vct/cascaded_voxel_texture.hpp"
 #include "accel/vct/dense_mip_texture.hpp"
 #include "core/render/ray_tracer.hpp"
@@ -114,7 +114,7 @@ private:
     std::string config_hash_;
     TracedScene scene_;
     DirectLighting lighting_;
-    AnisotropicVoxelizer voxelizer_;
+    FragmentVoxelizer voxelizer_;
     std::optional<CascadedVoxelTexture> cascade_;
     std::optional<DenseMipTexture> dense_;
     ConeSet diffuse_set_, injection_set_;

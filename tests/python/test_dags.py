@@ -1,5 +1,5 @@
 """gilab.ShadowDag and the time-correlated multi-frame DAG (gilab.MultiFrameDag,
-gilab.TemporalSvdag, gilab.build_animation_dag) against the same figures computed by
+gilab.LaidOutMultiFrameDag, gilab.build_animation_dag) against the same figures computed by
 `gilab experiment dag-table4 / dag-table5 --quick`, and against invariants that can fail:
 the depth-map rule, ray-traced shadows, decoding, static scenes."""
 import json

@@ -10,7 +10,7 @@
 #include "accel/dag/dag_ray_caster.hpp"
 #include "accel/temporal/multi_frame_dag.hpp"
 #include "accel/dag/svdag.hpp"
-#include "accel/dag/temporal_svdag.hpp"
+#include "accel/temporal/laid_out_multi_frame_dag.hpp"
 #include "accel/dag/voxel_ray_traversal.hpp"
 #include "core/util/morton.hpp"
 #include "core/voxel/voxelizer.hpp"
@@ -142,7 +142,7 @@ TEST(DagRayCaster, EveryFrameOfAMultiFrameDagMatches) {
         builder.append_frame(frames.back());
     }
     builder.append_frame(std::vector<uint64_t>{});
-    const TemporalSvdag temporal = builder.lay_out();
+    const LaidOutMultiFrameDag temporal = builder.lay_out();
     const std::vector<Ray> rays = gilab::test::traversal_test_rays();
     for (size_t f = 0; f < frames.size(); ++f) {
         const auto occupied = [&](const UVec3& v) { return temporal.contains_voxel(f, v); };

@@ -12,7 +12,7 @@
 #include "core/util/parallel.hpp"
 #include "core/render/ray_tracer.hpp"
 #include "core/scene/scene.hpp"
-#include "scenes/shadow_scenes.hpp"
+#include "scenes/villa_and_terrain.hpp"
 #include "tests/test_support.hpp"
 
 using namespace gilab;

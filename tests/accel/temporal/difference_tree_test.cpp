@@ -131,7 +131,7 @@ TEST(DifferenceTree, TimeCorrelatedNeverLarger) {
                 frames, (unsigned long long)svo_nn, double(svo_nn) / frames, (unsigned long long)tree.node_count(),
                 tree.nodes_per_frame(), (unsigned long long)svdag_nn, double(svdag_nn) / frames,
                 (unsigned long long)tc_nn, tc.nodes_per_frame());
-    const TemporalSvdag laid_out = tc.lay_out();
+    const LaidOutMultiFrameDag laid_out = tc.lay_out();
     std::printf("bytes: SVO pointerless %llu, difference tree %zu, SVDAG %llu, time-correlated %zu (32-bit), "
                 "%zu (minimal bits, offsets), %zu (minimal bits, indices)\n",
                 (unsigned long long)svo_nn, tree.bytes(), (unsigned long long)svdag_bytes, laid_out.bytes(),

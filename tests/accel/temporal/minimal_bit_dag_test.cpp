@@ -18,7 +18,7 @@ std::vector<uint64_t> moving_sphere_frame(int frame, uint32_t n) {
     return voxelize(soup.positions, soup.triangles, gilab::test::unit_grid(n)).codes;
 }
 
-TemporalSvdag build(const std::vector<std::vector<uint64_t>>& frames, uint32_t n) {
+LaidOutMultiFrameDag build(const std::vector<std::vector<uint64_t>>& frames, uint32_t n) {
     MultiFrameDag dag(gilab::test::unit_grid(n));
     for (const auto& f : frames) dag.append_frame(f);
     return dag.lay_out();
@@ -55,7 +55,7 @@ TEST(MinimalBitDag, BothEncodingsDecodeEveryFrame) {
         for (int f = 0; f < 5; ++f) frames.push_back(moving_sphere_frame(f, n));
         frames.insert(frames.begin() + 2, std::vector<uint64_t>{});
         frames.push_back(frames[0]);
-        const TemporalSvdag t = build(frames, n);
+        const LaidOutMultiFrameDag t = build(frames, n);
         for (PointerAddressing a : {PointerAddressing::BitOffset, PointerAddressing::NodeIndex}) {
             const MinimalBitDag m = encode_minimal_bits(t, a);
             ASSERT_EQ(m.frame_count(), frames.size());
@@ -73,7 +73,7 @@ TEST(MinimalBitDag, BothEncodingsDecodeEveryFrame) {
 //  * node indices: w_0 = ceil(log2 3) = 2; roots 12 + 14 → stream 50 bits = 7 B; root
 //    table 2 × 1 bit = 1 B; headers 18 B → 26 B.
 TEST(MinimalBitDag, HandMadeExampleHasTheExactBitCount) {
-    const TemporalSvdag t = build({{0, 9}, {0, 9, 63}}, 4);
+    const LaidOutMultiFrameDag t = build({{0, 9}, {0, 9, 63}}, 4);
     ASSERT_EQ(t.level_node_counts(), (std::vector<uint64_t>{2, 3, 1}));
     const MinimalBitDag offset = encode_minimal_bits(t, PointerAddressing::BitOffset);
     EXPECT_EQ(offset.pointer_bits(1), 0);
@@ -94,7 +94,7 @@ TEST(MinimalBitDag, HandMadeExampleHasTheExactBitCount) {
 }
 
 TEST(MinimalBitDag, NoPointerBitsAboveALevelOfOneNode) {
-    const TemporalSvdag t = build({moving_sphere_frame(0, 64), moving_sphere_frame(3, 64)}, 64);
+    const LaidOutMultiFrameDag t = build({moving_sphere_frame(0, 64), moving_sphere_frame(3, 64)}, 64);
     for (PointerAddressing a : {PointerAddressing::BitOffset, PointerAddressing::NodeIndex}) {
         const MinimalBitDag m = encode_minimal_bits(t, a);
         EXPECT_EQ(m.pointer_bits(t.depth() - 1), 0) << "the leaf level holds one node";
@@ -105,7 +105,7 @@ TEST(MinimalBitDag, NoPointerBitsAboveALevelOfOneNode) {
 TEST(MinimalBitDag, OffsetBytesAtLeastIndexBytes) {
     std::vector<std::vector<uint64_t>> frames;
     for (int f = 0; f < 6; ++f) frames.push_back(moving_sphere_frame(f, 64));
-    const TemporalSvdag t = build(frames, 64);
+    const LaidOutMultiFrameDag t = build(frames, 64);
     const MinimalBitDag offset = encode_minimal_bits(t, PointerAddressing::BitOffset);
     const MinimalBitDag index = encode_minimal_bits(t, PointerAddressing::NodeIndex);
     EXPECT_GE(offset.bytes(), index.bytes());

@@ -48,7 +48,7 @@ MultiFrameDag build_incremental(const std::vector<std::vector<uint64_t>>& frames
     return dag;
 }
 
-std::vector<uint32_t> words_of(const TemporalSvdag& t) { return {t.words().begin(), t.words().end()}; }
+std::vector<uint32_t> words_of(const LaidOutMultiFrameDag& t) { return {t.words().begin(), t.words().end()}; }
 
 // The cells of `split` level holding voxels of either frame, and those whose voxels differ.
 std::vector<uint64_t> cells_of(const std::vector<uint64_t>& codes, int shift) {
@@ -93,7 +93,7 @@ TEST(MultiFrameDag, EveryRootDecodesItsFrame) {
     const auto frames = moving_sphere_frames(6);
     ASSERT_NE(frames[0], frames[1]);
     MultiFrameDag dag = build_incremental(frames);
-    TemporalSvdag t = dag.lay_out();
+    LaidOutMultiFrameDag t = dag.lay_out();
     ASSERT_EQ(t.frame_count(), frames.size());
     EXPECT_EQ(t.level_node_counts()[0], frames.size()) << "one root per frame";
     for (size_t f = 0; f < frames.size(); ++f) {
@@ -128,14 +128,14 @@ TEST(MultiFrameDag, IncrementalEqualsAllAtOnce) {
     }
     EXPECT_GT(reused, 0u) << "clean cells must reuse the previous frame's subtrees";
 
-    const TemporalSvdag a = incremental.lay_out(), b = at_once.lay_out(), c = streaming.lay_out();
+    const LaidOutMultiFrameDag a = incremental.lay_out(), b = at_once.lay_out(), c = streaming.lay_out();
     EXPECT_EQ(words_of(a), words_of(b));
     EXPECT_EQ(words_of(a), words_of(c));
     EXPECT_EQ(a.level_node_counts(), b.level_node_counts());
     EXPECT_EQ(incremental.node_count(), at_once.node_count());
     EXPECT_EQ(incremental.live_level_counts(), at_once.live_level_counts());
     EXPECT_EQ(incremental.live_level_counts(), streaming.live_level_counts());
-    EXPECT_EQ(a.root(2), TemporalSvdag::kEmptyFrame);
+    EXPECT_EQ(a.root(2), LaidOutMultiFrameDag::kEmptyFrame);
     EXPECT_EQ(c.decode(3), frames[3]);
 }
 
@@ -143,7 +143,7 @@ TEST(MultiFrameDag, IdenticalFramesShareEverythingBelowTheRoot) {
     const auto a = moving_sphere_frame(0), b = moving_sphere_frame(3);
     MultiFrameDag aba = build_incremental({a, b, a});
     MultiFrameDag ab = build_incremental({a, b});
-    const TemporalSvdag t = aba.lay_out();
+    const LaidOutMultiFrameDag t = aba.lay_out();
     EXPECT_EQ(t.level_node_counts()[0], 3u) << "a repeated frame keeps its own root";
     const uint32_t r0 = t.root(0), r2 = t.root(2);
     ASSERT_NE(r0, r2);
@@ -161,7 +161,7 @@ TEST(MultiFrameDag, OneFrameEqualsPlainSvdag) {
     for (uint32_t n : {1u, 13u, 64u}) {
         const auto a = moving_sphere_frame(2, n);
         const Svdag plain = Svdag::from_voxels(gilab::test::unit_grid(n), a);
-        const TemporalSvdag t = build_incremental({a}, n).lay_out();
+        const LaidOutMultiFrameDag t = build_incremental({a}, n).lay_out();
         EXPECT_EQ(t.decode(0), plain.decode()) << "N = " << n;
         EXPECT_EQ(t.level_node_counts(), plain.level_node_counts()) << "N = " << n;
         EXPECT_EQ(t.node_count(), plain.node_count());
@@ -252,7 +252,7 @@ TEST(MultiFrameDag, RefCountsMatchRecount) {
                 << "level " << l << " node " << id;
         }
     }
-    const TemporalSvdag t = dag.lay_out();
+    const LaidOutMultiFrameDag t = dag.lay_out();
     for (size_t f = 0; f < dag.frame_count(); ++f) EXPECT_EQ(t.decode(f).empty(), dag.root_ids()[f] == MultiFrameDag::kEmptyFrame);
 }
 
@@ -262,8 +262,8 @@ TEST(MultiFrameDag, EmptyFrameAndBadInput) {
     dag.append_frame(std::vector<uint64_t>{1, 5, 9});
     dag.append_frame(std::vector<uint64_t>{});
     dag.append_frame(std::vector<uint64_t>{1, 5, 9});
-    const TemporalSvdag t = dag.lay_out();
-    EXPECT_EQ(t.root(1), TemporalSvdag::kEmptyFrame);
+    const LaidOutMultiFrameDag t = dag.lay_out();
+    EXPECT_EQ(t.root(1), LaidOutMultiFrameDag::kEmptyFrame);
     EXPECT_TRUE(t.decode(1).empty());
     EXPECT_EQ(t.decode(2), (std::vector<uint64_t>{1, 5, 9}));
     EXPECT_EQ(t.level_node_counts()[0], 2u) << "an empty frame has no root node";

@@ -1,4 +1,4 @@
-// Cascaded voxel texture and its anisotropic voxelizer: Fig. 2 layout, toroidal
+// Cascaded voxel texture and its fragment voxelizer: Fig. 2 layout, toroidal
 // addressing round trips (also after scrolling), nested snapped placement, per-face
 // opacities of walls, one-sided emission, scroll + re-voxelize = voxelize from scratch,
 // scroll filling from the coarser level, the anisotropic 2×2×2 filter, the dense mip
@@ -7,7 +7,7 @@
 
 #include <cstring>
 #include <set>
-#include "accel/vct/anisotropic_voxelizer.hpp"
+#include "accel/vct/fragment_voxelizer.hpp"
 #include "accel/vct/cascaded_voxel_texture.hpp"
 #include "accel/vct/dense_mip_texture.hpp"
 #include "core/util/error.hpp"
@@ -126,10 +126,10 @@ TEST(CascadedVoxelTexture, AddressingRoundTripsAlsoAfterScrolling) {
     EXPECT_EQ(t.finest_level_containing(DVec3(1e6)), -1);
 }
 
-TEST(AnisotropicVoxelizer, AxisAlignedWallGivesOpaqueXFacesOnly) {
+TEST(FragmentVoxelizer, AxisAlignedWallGivesOpaqueXFacesOnly) {
     // Voxels of 1 unit; the wall x = 2.5 cuts voxel column x = 2 through its centre.
     SceneFrame frame = frame_of({wall_x(2.5f, 0.0f, 4.0f, 0.0f, 4.0f)});
-    AnisotropicVoxelizer vox(frame, two_materials());
+    FragmentVoxelizer vox(frame, two_materials());
     auto voxels = vox.voxelize({DVec3(0.0), 1.0}, {IVec3(0), IVec3(4)});
     ASSERT_EQ(voxels.size(), 16u);
     for (const AnisotropicVoxel& v : voxels) {
@@ -146,11 +146,11 @@ TEST(AnisotropicVoxelizer, AxisAlignedWallGivesOpaqueXFacesOnly) {
     }
 }
 
-TEST(AnisotropicVoxelizer, PartialAndSlantedCoverage) {
+TEST(FragmentVoxelizer, PartialAndSlantedCoverage) {
     // Half of the voxel's cross-section covered: opacity 1/2.
     {
         SceneFrame frame = frame_of({wall_x(0.5f, 0.0f, 0.5f, 0.0f, 1.0f)});
-        auto voxels = AnisotropicVoxelizer(frame, two_materials()).voxelize({DVec3(0.0), 1.0}, {IVec3(0), IVec3(1)});
+        auto voxels = FragmentVoxelizer(frame, two_materials()).voxelize({DVec3(0.0), 1.0}, {IVec3(0), IVec3(1)});
         ASSERT_EQ(voxels.size(), 1u);
         EXPECT_NEAR(voxels[0].faces[kFacePosX].opacity, 0.5f, 1e-6f);
     }
@@ -158,7 +158,7 @@ TEST(AnisotropicVoxelizer, PartialAndSlantedCoverage) {
     // faces each see coverage 1 and the Z faces none.
     {
         SceneFrame frame = frame_of({{Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 1, 1), Vec3(1, 0, 1)}});
-        auto voxels = AnisotropicVoxelizer(frame, two_materials()).voxelize({DVec3(0.0), 1.0}, {IVec3(0), IVec3(1)});
+        auto voxels = FragmentVoxelizer(frame, two_materials()).voxelize({DVec3(0.0), 1.0}, {IVec3(0), IVec3(1)});
         ASSERT_EQ(voxels.size(), 1u);
         EXPECT_NEAR(voxels[0].faces[kFacePosX].opacity, 1.0f, 1e-5f);
         EXPECT_NEAR(voxels[0].faces[kFaceNegY].opacity, 1.0f, 1e-5f);
@@ -166,17 +166,17 @@ TEST(AnisotropicVoxelizer, PartialAndSlantedCoverage) {
     }
 }
 
-TEST(AnisotropicVoxelizer, WallOnALatticePlaneBelongsToOneVoxelLayer) {
+TEST(FragmentVoxelizer, WallOnALatticePlaneBelongsToOneVoxelLayer) {
     SceneFrame frame = frame_of({wall_x(2.0f, 0.0f, 4.0f, 0.0f, 4.0f)});
-    auto voxels = AnisotropicVoxelizer(frame, two_materials()).voxelize({DVec3(0.0), 1.0}, {IVec3(0), IVec3(4)});
+    auto voxels = FragmentVoxelizer(frame, two_materials()).voxelize({DVec3(0.0), 1.0}, {IVec3(0), IVec3(4)});
     ASSERT_EQ(voxels.size(), 16u);
     for (const AnisotropicVoxel& v : voxels) EXPECT_EQ(v.coord.x, 2);
 }
 
-TEST(AnisotropicVoxelizer, EmissionIsOneSided) {
+TEST(FragmentVoxelizer, EmissionIsOneSided) {
     // Emitter facing −Y (a ceiling light): only the −Y face of its voxels emits.
     SceneFrame frame = frame_of({{Vec3(0, 0.5f, 0), Vec3(1, 0.5f, 0), Vec3(1, 0.5f, 1), Vec3(0, 0.5f, 1), 1}});
-    auto voxels = AnisotropicVoxelizer(frame, two_materials()).voxelize({DVec3(0.0), 1.0}, {IVec3(0), IVec3(1)});
+    auto voxels = FragmentVoxelizer(frame, two_materials()).voxelize({DVec3(0.0), 1.0}, {IVec3(0), IVec3(1)});
     ASSERT_EQ(voxels.size(), 1u);
     EXPECT_EQ(voxels[0].faces[kFaceNegY].emission, Vec3(3, 2, 1));
     EXPECT_EQ(voxels[0].faces[kFacePosY].emission, Vec3(0));
@@ -206,7 +206,7 @@ void expect_same_level(const CascadedVoxelTexture& a, const CascadedVoxelTexture
 TEST(CascadedVoxelTexture, ScrollThenRevoxelizeEqualsVoxelizingFromScratch) {
     Scene cornell = make_cornell_box();
     SceneFrame frame = cornell.evaluate(0);
-    AnisotropicVoxelizer vox(frame, cornell.materials);
+    FragmentVoxelizer vox(frame, cornell.materials);
     CascadeConfig config = small_config(3, 16, 1.0 / 64.0);
     config.anchor = DVec3(-0.013, 0.002, -0.007);  // an arbitrary lattice
     CascadedVoxelTexture moving(config);
@@ -288,7 +288,7 @@ TEST(AnisotropicFilter, FrontChildHidesTheBackOneAlongTheFaceAxis) {
 
 TEST(CascadedVoxelTexture, DownsampleFillsTheInnerBoxFromTheFinerLevel) {
     SceneFrame frame = frame_of({wall_x(0.3f, -4.0f, 4.0f, -4.0f, 4.0f)});
-    AnisotropicVoxelizer vox(frame, two_materials());
+    FragmentVoxelizer vox(frame, two_materials());
     CascadedVoxelTexture t(small_config(2, 8, 0.25));
     for (int k = 1; k >= 0; --k) {
         t.place(k, t.origin_for(DVec3(0.0), k));
@@ -309,10 +309,10 @@ TEST(CascadedVoxelTexture, DownsampleFillsTheInnerBoxFromTheFinerLevel) {
     }
 }
 
-TEST(AnisotropicVoxelizer, SameVoxelsAtAnyThreadCount) {
+TEST(FragmentVoxelizer, SameVoxelsAtAnyThreadCount) {
     Scene cornell = make_cornell_box();
     SceneFrame frame = cornell.evaluate(0);
-    AnisotropicVoxelizer vox(frame, cornell.materials);
+    FragmentVoxelizer vox(frame, cornell.materials);
     auto run = [&](int threads) {
         ThreadLimit limit(threads);
         return vox.voxelize({DVec3(-0.01), 1.0 / 48.0}, {IVec3(0), IVec3(50)});
@@ -373,7 +373,7 @@ TEST(CascadedVoxelTexture, RejectsBadConfigurations) {
     EXPECT_NE(message(c).find("voxel size"), std::string::npos);
     SceneFrame frame = frame_of({wall_x(0.5f, 0, 1, 0, 1, 7)});
     try {
-        AnisotropicVoxelizer v(frame, two_materials());
+        FragmentVoxelizer v(frame, two_materials());
         FAIL();
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("material 7"), std::string::npos) << e.what();
@@ -392,7 +392,7 @@ namespace {
 TEST(CascadedVoxelTexture, OwnPartsFollowTheFinerLevelWhenScrolling) {
     Scene cornell = make_cornell_box();
     SceneFrame frame = cornell.evaluate(0);
-    AnisotropicVoxelizer vox(frame, cornell.materials);
+    FragmentVoxelizer vox(frame, cornell.materials);
     CascadeConfig config = small_config(3, 16, 1.0 / 64.0);
     auto build = [&](const DVec3& p) {
         CascadedVoxelTexture t(config);

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 #include <cmath>
 #include "core/util/parallel.hpp"
-#include "scenes/shadow_scenes.hpp"
+#include "scenes/villa_and_terrain.hpp"
 #include "techniques/dag_shadows/dag_shadows_technique.hpp"
 #include "tests/test_support.hpp"
 

@@ -173,7 +173,7 @@ TEST(ConeTracer, EmptySpaceGivesNothingAndAWallSaturates) {
         wall.material_ids.insert(wall.material_ids.end(), {0, 0});
     }
     frame.meshes.push_back(wall);
-    AnisotropicVoxelizer vox(frame, {Material{}});
+    FragmentVoxelizer vox(frame, {Material{}});
     CascadeConfig c;
     c.levels = 4;
     c.resolution = 16;

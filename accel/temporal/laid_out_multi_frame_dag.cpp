@@ -1,4 +1,4 @@
-#include "accel/dag/temporal_svdag.hpp"
+#include "accel/temporal/laid_out_multi_frame_dag.hpp"
 #include <string>
 #include <unordered_set>
 #include "accel/dag/child_mask.hpp"
@@ -8,8 +8,9 @@
 
 namespace gilab {
 
-TemporalSvdag::TemporalSvdag(const VoxelGrid& grid, std::vector<uint32_t> words, std::vector<uint64_t> level_begin,
-                             std::vector<uint64_t> level_counts, std::vector<uint32_t> roots, uint64_t pointer_count)
+LaidOutMultiFrameDag::LaidOutMultiFrameDag(const VoxelGrid& grid, std::vector<uint32_t> words,
+                                           std::vector<uint64_t> level_begin, std::vector<uint64_t> level_counts,
+                                           std::vector<uint32_t> roots, uint64_t pointer_count)
     : grid_(grid),
       depth_(grid.depth()),
       words_(std::move(words)),
@@ -18,20 +19,20 @@ TemporalSvdag::TemporalSvdag(const VoxelGrid& grid, std::vector<uint32_t> words,
       roots_(std::move(roots)),
       pointer_count_(pointer_count) {}
 
-uint32_t TemporalSvdag::root(size_t frame) const {
+uint32_t LaidOutMultiFrameDag::root(size_t frame) const {
     if (frame >= roots_.size())
         throw Error("multi-frame DAG", "frame " + std::to_string(frame) + " is outside 0.." +
                                            std::to_string(roots_.size()) + " (exclusive)");
     return roots_[frame];
 }
 
-uint32_t TemporalSvdag::child(uint32_t node, int slot) const {
+uint32_t LaidOutMultiFrameDag::child(uint32_t node, int slot) const {
     uint32_t m = words_[node] & 0xffu;
     if (!(m & (1u << slot))) return kEmptyFrame;
     return words_[node + 1 + child_rank(m, slot)];
 }
 
-std::vector<uint64_t> TemporalSvdag::decode(size_t frame) const {
+std::vector<uint64_t> LaidOutMultiFrameDag::decode(size_t frame) const {
     const uint32_t r = root(frame);
     if (r == kEmptyFrame) return {};
     return collect_leaf_codes(
@@ -39,7 +40,7 @@ std::vector<uint64_t> TemporalSvdag::decode(size_t frame) const {
         [&](uint32_t, int level) { return level == depth_; });
 }
 
-bool TemporalSvdag::contains_voxel(size_t frame, const UVec3& v) const {
+bool LaidOutMultiFrameDag::contains_voxel(size_t frame, const UVec3& v) const {
     uint32_t node = root(frame);
     if (node == kEmptyFrame || v.x >= grid_.resolution || v.y >= grid_.resolution || v.z >= grid_.resolution)
         return false;
@@ -51,7 +52,7 @@ bool TemporalSvdag::contains_voxel(size_t frame, const UVec3& v) const {
     return true;
 }
 
-size_t TemporalSvdag::reachable_node_count(size_t frame) const {
+size_t LaidOutMultiFrameDag::reachable_node_count(size_t frame) const {
     const uint32_t r = root(frame);
     if (r == kEmptyFrame) return 0;
     std::unordered_set<uint32_t> seen{r};
@@ -66,17 +67,17 @@ size_t TemporalSvdag::reachable_node_count(size_t frame) const {
     return seen.size();
 }
 
-size_t TemporalSvdag::node_count() const {
+size_t LaidOutMultiFrameDag::node_count() const {
     size_t n = 0;
     for (uint64_t c : level_counts_) n += c;
     return n;
 }
 
-double TemporalSvdag::nodes_per_frame() const {
+double LaidOutMultiFrameDag::nodes_per_frame() const {
     return roots_.empty() ? 0.0 : double(node_count()) / double(roots_.size());
 }
 
-Stats TemporalSvdag::stats() const {
+Stats LaidOutMultiFrameDag::stats() const {
     Stats s;
     s.set("frames", double(frame_count()));
     s.set("nodes", double(node_count()));
@@ -85,6 +86,21 @@ Stats TemporalSvdag::stats() const {
     s.set("bytes", double(bytes()));
     for (size_t l = 0; l < level_counts_.size(); ++l) s.set("nodes_level_" + std::to_string(l), double(level_counts_[l]));
     return s;
+}
+
+DagWordsView dag_view(const LaidOutMultiFrameDag& dag, size_t frame) {
+    DagWordsView v;
+    v.words = dag.words();
+    v.depth = dag.depth();
+    v.grid = dag.grid();
+    const uint32_t root = dag.root(frame);  // throws for a frame outside the animation
+    v.empty = root == LaidOutMultiFrameDag::kEmptyFrame;
+    v.root = v.empty ? 0 : root;
+    return v;
+}
+
+VoxelRayHit trace_voxel_ray(const LaidOutMultiFrameDag& dag, size_t frame, const Ray& ray) {
+    return trace_voxel_ray(dag_view(dag, frame), ray);
 }
 
 }  // namespace gilab

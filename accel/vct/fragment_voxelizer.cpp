@@ -1,4 +1,4 @@
-#include "accel/vct/anisotropic_voxelizer.hpp"
+#include "accel/vct/fragment_voxelizer.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -61,8 +61,8 @@ struct VoxelSums {
 
 }  // namespace
 
-AnisotropicVoxelizer::AnisotropicVoxelizer(const SceneFrame& frame, const std::vector<Material>& materials,
-                                           const std::vector<bool>& include_mesh) {
+FragmentVoxelizer::FragmentVoxelizer(const SceneFrame& frame, const std::vector<Material>& materials,
+                                     const std::vector<bool>& include_mesh) {
     for (size_t m = 0; m < frame.meshes.size(); ++m) {
         if (!include_mesh.empty() && (m >= include_mesh.size() || !include_mesh[m])) continue;
         const WorldMesh& mesh = frame.meshes[m];
@@ -70,17 +70,17 @@ AnisotropicVoxelizer::AnisotropicVoxelizer(const SceneFrame& frame, const std::v
             const UVec3& idx = mesh.triangles[t];
             uint32_t id = t < mesh.material_ids.size() ? mesh.material_ids[t] : 0;
             if (id >= materials.size())
-                throw Error("anisotropic voxelizer", "mesh " + std::to_string(m) + " triangle " + std::to_string(t) +
-                                                         " uses material " + std::to_string(id) + " but there are " +
-                                                         std::to_string(materials.size()));
+                throw Error("fragment voxelizer", "mesh " + std::to_string(m) + " triangle " + std::to_string(t) +
+                                                      " uses material " + std::to_string(id) + " but there are " +
+                                                      std::to_string(materials.size()));
             Triangle tri;
             for (int k = 0; k < 3; ++k) {
                 if (idx[k] >= mesh.positions.size())
-                    throw Error("anisotropic voxelizer", "mesh " + std::to_string(m) + " triangle " +
-                                                             std::to_string(t) + " refers to a missing vertex");
+                    throw Error("fragment voxelizer", "mesh " + std::to_string(m) + " triangle " +
+                                                          std::to_string(t) + " refers to a missing vertex");
                 const Vec3& p = mesh.positions[idx[k]];
                 if (!is_finite(p))
-                    throw Error("anisotropic voxelizer",
+                    throw Error("fragment voxelizer",
                                 "mesh " + std::to_string(m) + " has a non-finite vertex position");
                 tri.p[k] = DVec3(p);
             }
@@ -100,8 +100,8 @@ AnisotropicVoxelizer::AnisotropicVoxelizer(const SceneFrame& frame, const std::v
     }
 }
 
-std::vector<AnisotropicVoxel> AnisotropicVoxelizer::voxelize(const VoxelLattice& lattice, const VoxelBox& region,
-                                                             FragmentVoxelizeStats* stats) const {
+std::vector<AnisotropicVoxel> FragmentVoxelizer::voxelize(const VoxelLattice& lattice, const VoxelBox& region,
+                                                          FragmentVoxelizeStats* stats) const {
     Stopwatch clock;
     FragmentVoxelizeStats local_stats;
     std::vector<std::vector<AnisotropicVoxel>> results;
@@ -123,14 +123,14 @@ std::vector<AnisotropicVoxel> AnisotropicVoxelizer::voxelize(const VoxelLattice&
     return out;
 }
 
-void AnisotropicVoxelizer::voxelize_each(const VoxelLattice& lattice, const VoxelBox& region, const VoxelSink& emit,
-                                         FragmentVoxelizeStats* stats, const VoxelBox& exclude) const {
+void FragmentVoxelizer::voxelize_each(const VoxelLattice& lattice, const VoxelBox& region, const VoxelSink& emit,
+                                      FragmentVoxelizeStats* stats, const VoxelBox& exclude) const {
     voxelize_each(lattice, std::span<const VoxelBox>(&region, 1), emit, stats, exclude);
 }
 
-void AnisotropicVoxelizer::voxelize_each(const VoxelLattice& lattice, std::span<const VoxelBox> boxes,
-                                         const VoxelSink& emit, FragmentVoxelizeStats* stats,
-                                         const VoxelBox& exclude) const {
+void FragmentVoxelizer::voxelize_each(const VoxelLattice& lattice, std::span<const VoxelBox> boxes,
+                                      const VoxelSink& emit, FragmentVoxelizeStats* stats,
+                                      const VoxelBox& exclude) const {
     Stopwatch clock;
     FragmentVoxelizeStats local_stats;
     run(lattice, boxes, exclude, local_stats, [](size_t) {}, [&](size_t, const AnisotropicVoxel& v) { emit(v); });
@@ -138,12 +138,12 @@ void AnisotropicVoxelizer::voxelize_each(const VoxelLattice& lattice, std::span<
     if (stats) *stats = local_stats;
 }
 
-void AnisotropicVoxelizer::run(const VoxelLattice& lattice, std::span<const VoxelBox> all_boxes,
-                               const VoxelBox& exclude, FragmentVoxelizeStats& stats,
-                               const std::function<void(size_t)>& on_groups, const GroupSink& sink) const {
+void FragmentVoxelizer::run(const VoxelLattice& lattice, std::span<const VoxelBox> all_boxes,
+                            const VoxelBox& exclude, FragmentVoxelizeStats& stats,
+                            const std::function<void(size_t)>& on_groups, const GroupSink& sink) const {
     const double w = lattice.voxel_size;
     if (!(w > 0) || !std::isfinite(w))
-        throw Error("anisotropic voxelizer", "voxel size must be positive and finite, got " + std::to_string(w));
+        throw Error("fragment voxelizer", "voxel size must be positive and finite, got " + std::to_string(w));
     std::vector<VoxelBox> boxes;
     VoxelBox region{IVec3(std::numeric_limits<int>::max()), IVec3(std::numeric_limits<int>::min())};
     for (const VoxelBox& b : all_boxes)

@@ -1,6 +1,7 @@
-// The shadow-DAG scenes: every villa mesh is a closed, consistently outward-wound solid;
-// the fBm terrain is one open, upward-facing, deterministic heightfield; both validate
-// and are lit by a directional sun first. Also reports how closed the shared castle is.
+// The villa and the fBm terrain (the shadow-DAG paper's stand-ins): every villa mesh is a
+// closed, consistently outward-wound solid; the fBm terrain is one open, upward-facing,
+// deterministic heightfield; both validate and are lit by a directional sun first. Also
+// reports how closed the shared castle is.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -16,7 +17,7 @@
 #include "scenes/builtin_scenes.hpp"
 #include "scenes/procedural_meshes.hpp"
 #include "scenes/scene_library.hpp"
-#include "scenes/shadow_scenes.hpp"
+#include "scenes/villa_and_terrain.hpp"
 #include "tests/test_support.hpp"
 
 using namespace gilab;
@@ -228,7 +229,7 @@ TEST(FbmTerrainScene, ValidatesWithLowSunFirstAndViews) {
     EXPECT_NE(test::error_of([] { make_fbm_terrain(1); }), "<no error>");
 }
 
-TEST(ShadowScenes, RegisteredAndOpenableByName) {
+TEST(VillaAndTerrain, RegisteredAndOpenableByName) {
     for (const char* name : {"villa", "fbm_terrain"}) {
         SCOPED_TRACE(name);
         const BuiltinScene* builtin = find_builtin(name);
@@ -242,7 +243,7 @@ TEST(ShadowScenes, RegisteredAndOpenableByName) {
 
 // The shared castle model: how much of it is closed. The castle OBJ is the one the scene
 // file loads; the ground is a single quad and so open by construction.
-TEST(ShadowScenes, SharedCastleClosedness) {
+TEST(CastleScene, SharedCastleClosedness) {
     if (!test::shared_asset("castle/fincastel.obj")) GTEST_SKIP() << "shared asset castle/fincastel.obj not found";
     const OpenedScene opened = open_scene("castle", AssetPaths::from_environment());
     for (const std::string& w : opened.warnings) std::cout << "castle warning: " << w << "\n";

@@ -1,4 +1,4 @@
-#include "techniques/dag_raycast/animation_dag.hpp"
+#include "accel/temporal/animation_dag.hpp"
 
 #include <string>
 #include <unordered_map>
@@ -65,6 +65,10 @@ void build_all_at_once(const Scene& scene, const std::vector<double>& times, Mul
 }
 
 }  // namespace
+
+const char* to_string(DagBuildMode mode) {
+    return mode == DagBuildMode::Incremental ? "incremental" : "all_at_once";
+}
 
 AnimationDag build_animation_dag(const Scene& scene, const AnimationDagOptions& options) {
     if (options.frames < 1)

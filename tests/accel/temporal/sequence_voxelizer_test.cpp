@@ -19,7 +19,7 @@
 #include "core/voxel/voxelizer.hpp"
 #include "scenes/fire_scene.hpp"
 #include "scenes/procedural_meshes.hpp"
-#include "techniques/dag_raycast/animation_dag.hpp"
+#include "accel/temporal/animation_dag.hpp"
 #include "tests/test_support.hpp"
 #include "tests/voxel_test_meshes.hpp"
 
@@ -252,7 +252,7 @@ TEST(SequenceVoxelizer, StreamedDagEqualsAllAtOnce) {
         frames.push_back(Svdag::from_voxels(grid, voxelize(scene.evaluate(t), grid).codes));
     }
     EXPECT_GT(reused, 0u);
-    const TemporalSvdag a = streamed.lay_out(), b = MultiFrameDag::merge_all(frames).lay_out();
+    const LaidOutMultiFrameDag a = streamed.lay_out(), b = MultiFrameDag::merge_all(frames).lay_out();
     EXPECT_EQ(a.node_count(), b.node_count());
     EXPECT_TRUE(std::ranges::equal(a.words(), b.words()));
 }

@@ -1,4 +1,4 @@
-#include "scenes/shadow_scenes.hpp"
+#include "scenes/villa_and_terrain.hpp"
 
 #include <cstdint>
 #include <string>

@@ -1,26 +1,28 @@
 #pragma once
-// The multi-frame DAG laid out in P2's 32-bit format (§2.2, §4): per node a word with
-// the 8-bit child mask, then one word address per non-empty child. Level 0 holds one
-// root node per non-empty frame in time order (repeated frames repeat their root), so
-// frame f is rendered by starting at root(f); everything below is shared across space
-// and time. The single leaf node (mask 0) is the last word.
+// The multi-frame DAG laid out in P2's 32-bit format (§2.2, §4), as the builder
+// MultiFrameDag::lay_out (accel/temporal/multi_frame_dag.hpp) gives it: per node a word
+// with the 8-bit child mask, then one word address per non-empty child. Level 0 holds
+// one root node per non-empty frame in time order (repeated frames repeat their root),
+// so frame f is rendered by starting at root(f); everything below is shared across
+// space and time. The single leaf node (mask 0) is the last word.
 #include <cstdint>
 #include <span>
 #include <vector>
+#include "accel/dag/voxel_ray_traversal.hpp"
 #include "core/util/math.hpp"
 #include "core/util/stats.hpp"
 #include "core/voxel/voxel_grid.hpp"
 
 namespace gilab {
 
-class TemporalSvdag {
+class LaidOutMultiFrameDag {
 public:
     static constexpr uint32_t kEmptyFrame = 0xffffffffu;
 
-    TemporalSvdag() = default;
+    LaidOutMultiFrameDag() = default;
     // `roots` holds one word address per frame, kEmptyFrame for a frame with no voxels.
-    TemporalSvdag(const VoxelGrid& grid, std::vector<uint32_t> words, std::vector<uint64_t> level_begin,
-                  std::vector<uint64_t> level_counts, std::vector<uint32_t> roots, uint64_t pointer_count);
+    LaidOutMultiFrameDag(const VoxelGrid& grid, std::vector<uint32_t> words, std::vector<uint64_t> level_begin,
+                         std::vector<uint64_t> level_counts, std::vector<uint32_t> roots, uint64_t pointer_count);
 
     const VoxelGrid& grid() const { return grid_; }
     int depth() const { return depth_; }
@@ -55,5 +57,13 @@ private:
     std::vector<uint32_t> roots_;
     uint64_t pointer_count_ = 0;
 };
+
+// Frame `frame` as a DAG in the 32-bit word format, for cast_dag_ray
+// (accel/dag/dag_ray_caster.hpp) and trace_voxel_ray. Throws Error for a frame outside
+// the animation.
+DagWordsView dag_view(const LaidOutMultiFrameDag& dag, size_t frame);
+// Through the root of `frame` (an empty frame is never hit). Throws Error for a frame
+// outside the animation.
+VoxelRayHit trace_voxel_ray(const LaidOutMultiFrameDag& dag, size_t frame, const Ray& ray);
 
 }  // namespace gilab

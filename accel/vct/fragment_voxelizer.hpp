@@ -1,7 +1,8 @@
 #pragma once
-// Fragment voxelization with per-face attributes, for voxel cone tracing. Every triangle
-// is clipped against every voxel box it may meet (Sutherland–Hodgman, in double); a
-// clipped piece of non-zero area is a fragment. Fragments in one voxel are fused: for
+// Fragment voxelization with per-face attributes, for voxel cone tracing. P3 (§1.1)
+// rasterises each triangle into fragments and fuses the fragments of a voxel; here every
+// triangle is clipped against every voxel box it may meet (Sutherland–Hodgman, in double)
+// and a clipped piece of non-zero area is a fragment. Fragments in one voxel are fused: for
 // face f (axis k) a fragment of area A and unit normal n weighs A·|n_k|; the face's
 // opacity is Σ A·|n_k| / voxel_area clamped to 1 (projected coverage), its albedo,
 // oriented normal, emission and position are the weighted means. Emission counts only
@@ -50,14 +51,14 @@ struct FragmentVoxelizeStats {
     uint64_t voxels = 0;      // occupied voxels returned
 };
 
-class AnisotropicVoxelizer {
+class FragmentVoxelizer {
 public:
-    AnisotropicVoxelizer() = default;
+    FragmentVoxelizer() = default;
     // Triangles of the frame's meshes for which include_mesh[m] is true (all meshes when
     // include_mesh is empty). Materials give albedo and emission. Throws Error for a
     // material id out of range or a non-finite vertex.
-    AnisotropicVoxelizer(const SceneFrame& frame, const std::vector<Material>& materials,
-                         const std::vector<bool>& include_mesh = {});
+    FragmentVoxelizer(const SceneFrame& frame, const std::vector<Material>& materials,
+                      const std::vector<bool>& include_mesh = {});
 
     size_t triangle_count() const { return triangles_.size(); }
     Bounds3 bounds() const { return bounds_; }

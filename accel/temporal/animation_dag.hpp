@@ -7,13 +7,16 @@
 // about the shared DAG plus one batch of cells. The all-at-once build (mode (a))
 // voxelizes whole frames, keeps every frame's SVDAG and merges them together at the end.
 #include <vector>
-#include "accel/dag/temporal_svdag.hpp"
+#include "accel/temporal/laid_out_multi_frame_dag.hpp"
 #include "core/scene/light.hpp"
 #include "core/scene/scene.hpp"
 #include "core/util/stats.hpp"
-#include "techniques/dag_raycast/dag_raycast_settings.hpp"
 
 namespace gilab {
+
+// How the frames are merged: Incremental is mode (b) above, AllAtOnce mode (a).
+enum class DagBuildMode { Incremental, AllAtOnce };
+const char* to_string(DagBuildMode mode);  // "incremental", "all_at_once"
 
 struct AnimationDagOptions {
     uint32_t resolution = 256;
@@ -23,7 +26,7 @@ struct AnimationDagOptions {
 };
 
 struct AnimationDag {
-    TemporalSvdag dag;
+    LaidOutMultiFrameDag dag;
     std::vector<double> times;                       // scene time of each frame
     std::vector<std::vector<PunctualLight>> lights;  // world-space lights of each frame
     // build_ms (all of it: the bounds pass, voxelizing, merging, laying out),
