@@ -104,7 +104,7 @@ struct StructureFigures {
     double structure_bytes = 0; // every array the implementation holds
     // The time from each voxelizer, so structures compare under one voxelizer; NaN where
     // a structure cannot be built from that voxelizer's output.
-    double ms_overlap = std::numeric_limits<double>::quiet_NaN();   // core/voxel/voxelizer (triangle/box overlap)
+    double ms_conservative = std::numeric_limits<double>::quiet_NaN();   // core/voxel/voxelizer (triangle/box overlap)
     double ms_fragment = std::numeric_limits<double>::quiet_NaN();  // fragment voxelizer (accel/vct/fragment_voxelizer)
 };
 struct SceneFigures {
@@ -178,7 +178,7 @@ SceneFigures measure_structures(const ExperimentContext& ctx, const Scene& scene
     out.by_structure["OpenVDB"] = {double(vdb->voxel_count()), double(vdb->voxel_count()), vox + median(t_vdb),
                                    double(vdb->bytes()), double(vdb->bytes())};
     for (const char* sparse : {"SVO", "MSVO", "SVDAG", "OpenVDB"})
-        out.by_structure[sparse].ms_overlap = out.by_structure[sparse].ms;
+        out.by_structure[sparse].ms_conservative = out.by_structure[sparse].ms;
 
     // Dense 3D texture: fragment voxelization of the whole grid written into one byte of
     // opacity per voxel (the isotropic texture the paper counts).
@@ -203,7 +203,7 @@ SceneFigures measure_structures(const ExperimentContext& ctx, const Scene& scene
     out.by_structure["3D texture"] = {n, dense_occupied, median(t_dense), double(texture.size()), double(texture.size())};
     out.by_structure["3D texture"].ms_fragment = median(t_dense);
     {
-        // The same texture from the overlap voxelizer's list.
+        // The same texture from the conservative voxelizer's list.
         std::vector<double> t_fill;
         for (int r = 0; r < repeats; ++r) {
             Stopwatch w;
@@ -214,11 +214,11 @@ SceneFigures measure_structures(const ExperimentContext& ctx, const Scene& scene
             }
             t_fill.push_back(w.elapsed_ms());
         }
-        out.by_structure["3D texture"].ms_overlap = vox + median(t_fill);
+        out.by_structure["3D texture"].ms_conservative = vox + median(t_fill);
     }
     {
         // The sparse structures from the fragment voxelizer: its occupied voxels gathered
-        // into a bitmap, listed in Morton order, then built exactly as from the overlap list.
+        // into a bitmap, listed in Morton order, then built exactly as from the conservative voxelizer's list.
         std::vector<double> t_list;
         std::vector<uint64_t> codes;
         for (int r = 0; r < repeats; ++r) {
@@ -418,7 +418,7 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, SceneSet set, Str
                          "fixed by construction"};
             break;
         case StructureQuantity::VoxelizationTime:
-            t.columns = {"scene", "resolution", "structure", "voxelize_ms (overlap voxelizer)",
+            t.columns = {"scene", "resolution", "structure", "voxelize_ms (conservative voxelizer)",
                          "voxelize_ms (fragment voxelizer)", "paper voxelize_ms"};
             break;
         case StructureQuantity::Memory:
@@ -448,7 +448,7 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, SceneSet set, Str
                     r["fixed by construction"] = fixed_by_construction(s);
                     break;
                 case StructureQuantity::VoxelizationTime:
-                    r["voxelize_ms (overlap voxelizer)"] = std::isnan(f.ms_overlap) ? nlohmann::json() : nlohmann::json(f.ms_overlap);
+                    r["voxelize_ms (conservative voxelizer)"] = std::isnan(f.ms_conservative) ? nlohmann::json() : nlohmann::json(f.ms_conservative);
                     r["voxelize_ms (fragment voxelizer)"] = std::isnan(f.ms_fragment) ? nlohmann::json() : nlohmann::json(f.ms_fragment);
                     r["paper voxelize_ms"] = p ? nlohmann::json(p->ms) : nlohmann::json();
                     break;
@@ -498,13 +498,13 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, SceneSet set, Str
         "(0.098 M = 3 × 32³ at 128³, 0.131 M = 4 × 32³ at 256³). occupied_millions = occupied leaf voxels.");
     out.notes.push_back(
         "Voxelization times, every structure from both voxelizers so that a ratio compares structures, not "
-        "voxelizers. Overlap voxelizer = conservative triangle/box overlap over the whole grid (core/voxel/voxelizer, a "
+        "voxelizers. Conservative voxelizer = triangle/box overlap over the whole grid (core/voxel/voxelizer, a "
         "Morton-sorted list); fragment voxelizer = triangles clipped per voxel with per-face coverage (the "
         "cascades' own). SVO, MSVO, SVDAG, OpenVDB = the voxelizer's occupied voxels as a Morton-sorted list plus "
         "the structure's own build; 3D texture = the voxels written into a dense byte texture; cascaded = fragment "
         "voxelization with per-face attributes, each level only over its own part (its 32³ region minus the inner "
         "box the finer level covers, whose radiance is filtered from that level); the cascades need per-face "
-        "attributes, so they have no overlap-voxelizer time. The two voxelizers' voxel sets differ slightly at "
+        "attributes, so they have no conservative-voxelizer time. The two voxelizers' voxel sets differ slightly at "
         "triangle edges. CPU, all threads.");
     out.notes.push_back(
         "Memory: each structure charged its real encoding of occupancy (column 'encoding'): the 3D texture 1 B per "

@@ -114,15 +114,15 @@ TEST_F(VctExperiments, EveryStructureIsTimedFromBothVoxelizers) {
     const ExperimentOutput out = test::run_quick_experiment(vct_registry(), "vct-table3");
     int rows = 0;
     for (const json& row : out.tables.at(0).rows) {
-        const json& overlap = row.at("voxelize_ms (overlap voxelizer)");
+        const json& conservative = row.at("voxelize_ms (conservative voxelizer)");
         const json& fragment = row.at("voxelize_ms (fragment voxelizer)");
         ASSERT_TRUE(fragment.is_number()) << row.dump();
         EXPECT_GT(fragment.get<double>(), 0.0);
         if (row.at("structure") == "cascaded") {
-            EXPECT_TRUE(overlap.is_null()) << row.dump();
+            EXPECT_TRUE(conservative.is_null()) << row.dump();
         } else {
-            ASSERT_TRUE(overlap.is_number()) << row.dump();
-            EXPECT_GT(overlap.get<double>(), 0.0);
+            ASSERT_TRUE(conservative.is_number()) << row.dump();
+            EXPECT_GT(conservative.get<double>(), 0.0);
         }
         ++rows;
     }
