@@ -24,10 +24,7 @@ namespace {
 
 Film render(const std::string& technique, const Scene& scene, const EyeCamera& camera, nlohmann::json settings_json,
             Stats* stats = nullptr) {
-    auto t = TechniqueRegistry::builtin().create(technique);
-    Settings settings(std::move(settings_json), "test settings");
-    t->prepare(scene, settings);
-    settings.report_unused();
+    auto t = prepare_technique(technique, scene, Settings(std::move(settings_json), "test settings"));
     std::vector<Film> films;
     t->render(ViewSet::mono(camera), films);
     if (stats) *stats = t->stats();
@@ -366,9 +363,8 @@ TEST(PhotonMapping, EveryHitStoresACopyAtTheFirstHit) {
     // adds one copy per photon that reached a surface. Counted independently by tracing
     // the same photons to their first hit only; in a closed sphere every photon hits.
     auto prepared = [](const Scene& scene, const std::string& storage) {
-        auto t = TechniqueRegistry::builtin().create("photon");
-        t->prepare(scene, Settings(nlohmann::json{{"photons", 20000}, {"seed", 4}, {"photon_storage", storage}}));
-        return t;
+        const Settings s(nlohmann::json{{"photons", 20000}, {"seed", 4}, {"photon_storage", storage}});
+        return prepare_technique("photon", scene, s);
     };
     auto first_hits = [](const Scene& scene) {
         SceneFrame frame = scene.evaluate(0);
