@@ -110,7 +110,7 @@ struct ExpectedImage {
 
 ExpectedImage expected_image(const Scene& scene, const EyeCamera& camera, const nlohmann::json& settings_json) {
     PhotonMappingTechnique t;
-    t.prepare(scene, Settings(settings_json));
+    prepare_technique(t, scene, Settings(settings_json));
     const PhotonMappingSettings& s = t.settings();
     const SceneFrame frame = scene.evaluate(0);
     const RayTracer tracer(frame);
