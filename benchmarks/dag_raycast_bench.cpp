@@ -31,8 +31,8 @@ PreparedScene* prepared(const std::string& name) {
     try {
         p = std::make_unique<PreparedScene>();
         p->scene = open_scene(name, AssetPaths::from_environment()).scene;
-        p->technique = TechniqueRegistry::builtin().create("dag_raycast");
-        p->technique->prepare(p->scene, Settings(nlohmann::json{{"resolution", 512}, {"frames", 2}}, "bench"));
+        const Settings settings(nlohmann::json{{"resolution", 512}, {"frames", 2}}, "bench");
+        p->technique = prepare_technique("dag_raycast", p->scene, settings);
     } catch (const std::exception&) {
         p.reset();
     }

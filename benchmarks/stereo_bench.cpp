@@ -39,8 +39,7 @@ struct Fixture {
         auto& slot = techniques[variant];
         if (!slot) {
             slot = std::make_unique<PhotonMappingTechnique>();
-            Settings s(settings_of(variant), "stereo benchmark");
-            slot->prepare(scene, s);
+            prepare_technique(*slot, scene, Settings(settings_of(variant), "stereo benchmark"));
         }
         return *slot;
     }

@@ -30,6 +30,21 @@ std::unique_ptr<Technique> TechniqueRegistry::create(const std::string& name) co
     throw Error("technique '" + name + "'", "unknown technique (known: " + (known.empty() ? "none" : known) + ")");
 }
 
+void report_unused_settings(const Technique& technique, const Settings& settings) {
+    settings.report_unused("technique '" + technique.name() + "'");
+}
+
+void prepare_technique(Technique& technique, const Scene& scene, const Settings& settings) {
+    technique.prepare(scene, settings);
+    report_unused_settings(technique, settings);
+}
+
+std::unique_ptr<Technique> prepare_technique(const std::string& name, const Scene& scene, const Settings& settings) {
+    std::unique_ptr<Technique> technique = TechniqueRegistry::builtin().create(name);
+    prepare_technique(*technique, scene, settings);
+    return technique;
+}
+
 const TechniqueRegistry& TechniqueRegistry::builtin() {
     // One explicit line per technique: nothing depends on static initialisers.
     static const TechniqueRegistry registry = [] {

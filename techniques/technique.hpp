@@ -64,4 +64,15 @@ private:
     std::vector<TechniqueInfo> techniques_;
 };
 
+// The set-up every caller of a technique repeats. prepare_technique creates the built-in
+// technique `name` (an unknown name is an Error listing the known ones), prepares it for
+// `scene` with `settings`, then reports the settings it never read; the second form
+// prepares a technique already made. Errors name the settings' context (the caller)
+// and, for unread keys, the technique.
+std::unique_ptr<Technique> prepare_technique(const std::string& name, const Scene& scene, const Settings& settings);
+void prepare_technique(Technique& technique, const Scene& scene, const Settings& settings);
+// Throws Error naming every key of `settings` that `technique` did not read (misspelt,
+// or not one of its settings); for callers with checks of their own between the two.
+void report_unused_settings(const Technique& technique, const Settings& settings);
+
 }  // namespace gilab

@@ -10,6 +10,20 @@
 
 namespace gilab {
 
+// Linear sRGB (D65) ↔ CIE XYZ with the matrices of the FLIP papers (Andersson et al.
+// 2020, 2021): the forward one as exact ratios, the inverse as they publish it, so that
+// our FLIP matches theirs rather than a differently rounded sRGB standard.
+std::array<double, 3> flip_rgb_to_xyz(const std::array<double, 3>& c) {
+    return {(10135552.0 * c[0] + 8788810.0 * c[1] + 4435075.0 * c[2]) / 24577794.0,
+            (2613072.0 * c[0] + 8788810.0 * c[1] + 887015.0 * c[2]) / 12288897.0,
+            (1425312.0 * c[0] + 8788810.0 * c[1] + 70074185.0 * c[2]) / 73733382.0};
+}
+std::array<double, 3> flip_xyz_to_rgb(const std::array<double, 3>& c) {
+    return {3.241003275 * c[0] - 1.537398934 * c[1] - 0.498615861 * c[2],
+            -0.969224334 * c[0] + 1.875930071 * c[1] + 0.041554224 * c[2],
+            0.055639423 * c[0] - 0.204011202 * c[1] + 1.057148933 * c[2]};
+}
+
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -18,21 +32,8 @@ constexpr double kFeatureWidth = 0.082;                          // w, degrees
 
 using Rgb = std::array<double, 3>;
 
-// Linear sRGB (D65) ↔ CIE XYZ with the matrices of the FLIP papers (Andersson et al.
-// 2020, 2021): the forward one as exact ratios, the inverse as they publish it, so that
-// our FLIP matches theirs rather than a differently rounded sRGB standard.
-Rgb rgb_to_xyz(const Rgb& c) {
-    return {(10135552.0 * c[0] + 8788810.0 * c[1] + 4435075.0 * c[2]) / 24577794.0,
-            (2613072.0 * c[0] + 8788810.0 * c[1] + 887015.0 * c[2]) / 12288897.0,
-            (1425312.0 * c[0] + 8788810.0 * c[1] + 70074185.0 * c[2]) / 73733382.0};
-}
-Rgb xyz_to_rgb(const Rgb& c) {
-    return {3.241003275 * c[0] - 1.537398934 * c[1] - 0.498615861 * c[2],
-            -0.969224334 * c[0] + 1.875930071 * c[1] + 0.041554224 * c[2],
-            0.055639423 * c[0] - 0.204011202 * c[1] + 1.057148933 * c[2]};
-}
 // The reference white: linear RGB (1, 1, 1).
-const Rgb kWhite = rgb_to_xyz({1.0, 1.0, 1.0});
+const Rgb kWhite = flip_rgb_to_xyz({1.0, 1.0, 1.0});
 
 // YCxCz: CIELAB's opponent space without its non-linearity, where filtering is linear.
 Rgb xyz_to_ycxcz(const Rgb& c) {
@@ -63,7 +64,7 @@ double hyab(const Rgb& a, const Rgb& b) {
 // The largest colour difference: HyAB between Hunt-adjusted green and blue, to the power qc.
 double max_colour_difference() {
     static const double cmax =
-        std::pow(hyab(hunt(xyz_to_lab(rgb_to_xyz({0, 1, 0}))), hunt(xyz_to_lab(rgb_to_xyz({0, 0, 1})))), kQc);
+        std::pow(hyab(hunt(xyz_to_lab(flip_rgb_to_xyz({0, 1, 0}))), hunt(xyz_to_lab(flip_rgb_to_xyz({0, 0, 1})))), kQc);
     return cmax;
 }
 
@@ -121,7 +122,7 @@ std::array<ImagePlane, 3> to_ycxcz(const std::array<ImagePlane, 3>& rgb) {
     std::array<ImagePlane, 3> out;
     for (auto& p : out) p = ImagePlane(rgb[0].width, rgb[0].height);
     for (size_t i = 0; i < rgb[0].values.size(); ++i) {
-        const Rgb c = xyz_to_ycxcz(rgb_to_xyz({rgb[0].values[i], rgb[1].values[i], rgb[2].values[i]}));
+        const Rgb c = xyz_to_ycxcz(flip_rgb_to_xyz({rgb[0].values[i], rgb[1].values[i], rgb[2].values[i]}));
         for (int k = 0; k < 3; ++k) out[size_t(k)].values[i] = float(c[size_t(k)]);
     }
     return out;
@@ -133,9 +134,9 @@ std::vector<Rgb> perceived_colours(const std::array<ImagePlane, 3>& ycxcz, doubl
     for (int k = 0; k < 3; ++k) filtered[size_t(k)] = convolve(ycxcz[size_t(k)], csf_kernel(kCsf[k], ppd));
     std::vector<Rgb> lab(ycxcz[0].values.size());
     for (size_t i = 0; i < lab.size(); ++i) {
-        Rgb rgb = xyz_to_rgb(ycxcz_to_xyz({filtered[0].values[i], filtered[1].values[i], filtered[2].values[i]}));
+        Rgb rgb = flip_xyz_to_rgb(ycxcz_to_xyz({filtered[0].values[i], filtered[1].values[i], filtered[2].values[i]}));
         for (double& c : rgb) c = std::clamp(c, 0.0, 1.0);
-        lab[i] = hunt(xyz_to_lab(rgb_to_xyz(rgb)));
+        lab[i] = hunt(xyz_to_lab(flip_rgb_to_xyz(rgb)));
     }
     return lab;
 }

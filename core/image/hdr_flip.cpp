@@ -31,22 +31,12 @@ double median(std::vector<double> v) {
     return 0.5 * (lower + upper);
 }
 
-// The image at one exposure, tone-mapped as linear RGB planes in [0, 1]. NaN shows as
-// magenta, as in the PNG previews.
-std::array<ImagePlane, 3> tone_mapped(const Layer& layer, int width, int height, double exposure) {
+// The image at one exposure, tone-mapped as linear RGB planes in [0, 1] (NaN magenta, a
+// 1-channel layer grey, as display_planes shows them).
+std::array<ImagePlane, 3> tone_mapped(const Film& film, const std::string& layer, double exposure) {
     const double scale = std::exp2(exposure);
-    std::array<ImagePlane, 3> planes;
-    for (auto& p : planes) p = ImagePlane(width, height);
-    const int ch = layer.channels;
-    for (size_t i = 0; i < size_t(width) * size_t(height); ++i) {
-        const float* p = layer.data.data() + i * size_t(ch);
-        const float c[3] = {p[0], ch >= 3 ? p[1] : p[0], ch >= 3 ? p[2] : p[0]};
-        const bool nan = std::isnan(c[0]) || std::isnan(c[1]) || std::isnan(c[2]);
-        for (int k = 0; k < 3; ++k)
-            planes[size_t(k)].values[i] =
-                nan ? (k == 1 ? 0.0f : 1.0f) : float(hdr_flip_tone_map(scale * std::max(double(c[k]), 0.0)));
-    }
-    return planes;
+    return display_planes(film, layer,
+                          [scale](float v) { return float(hdr_flip_tone_map(scale * std::max(double(v), 0.0))); });
 }
 
 }  // namespace
@@ -67,7 +57,6 @@ HdrFlip hdr_flip_map(const Film& image, const Film& reference, const std::string
     check_comparable_layers(image, reference, layer_name, "hdr-flip");
     check_pixels_per_degree(ppd);
     const Layer& ref_layer = reference.layer(layer_name);
-    const Layer& test_layer = image.layer(layer_name);
     const int w = image.width(), h = image.height();
 
     std::vector<double> y;
@@ -99,8 +88,8 @@ HdrFlip hdr_flip_map(const Film& image, const Film& reference, const std::string
     out.flip.map = ImagePlane(w, h, 0.0f);
     for (int e = 0; e < out.exposures; ++e) {
         const double exposure = out.start_exposure + e * step;
-        const ImagePlane ldr = flip_of_display(tone_mapped(test_layer, w, h, exposure),
-                                               tone_mapped(ref_layer, w, h, exposure), ppd);
+        const ImagePlane ldr = flip_of_display(tone_mapped(image, layer_name, exposure),
+                                               tone_mapped(reference, layer_name, exposure), ppd);
         for (size_t i = 0; i < ldr.values.size(); ++i)
             out.flip.map.values[i] = std::max(out.flip.map.values[i], ldr.values[i]);
     }

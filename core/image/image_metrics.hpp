@@ -54,6 +54,9 @@ MetricMap flip_map(const Film& image, const Film& reference, const std::string& 
 ImagePlane flip_of_display(const std::array<ImagePlane, 3>& image, const std::array<ImagePlane, 3>& reference,
                            double pixels_per_degree);
 void check_pixels_per_degree(double pixels_per_degree);  // throws unless positive and finite
+// Linear sRGB (D65) to CIE XYZ and back as FLIP converts: with the FLIP papers' matrices.
+std::array<double, 3> flip_rgb_to_xyz(const std::array<double, 3>& linear_rgb);
+std::array<double, 3> flip_xyz_to_rgb(const std::array<double, 3>& xyz);
 
 // HDR-FLIP (Andersson, Nilsson, Shirley & Akenine-Möller 2021, "Visualizing Errors in
 // Rendered High Dynamic Range Images"), for the linear HDR layer itself rather than its

@@ -58,7 +58,7 @@ void Settings::check_number(const std::string& key, long double lo, long double 
     }
 }
 
-void Settings::report_unused() const {
+void Settings::report_unused(const std::string& reader) const {
     std::vector<std::string> unused;
     for (auto it = values_.begin(); it != values_.end(); ++it)
         if (!read_.count(it.key())) unused.push_back(it.key());
@@ -66,7 +66,7 @@ void Settings::report_unused() const {
     std::ostringstream msg;
     msg << (unused.size() == 1 ? "unknown setting " : "unknown settings ");
     for (size_t i = 0; i < unused.size(); ++i) msg << (i ? ", '" : "'") << unused[i] << "'";
-    msg << " (misspelt, or not used by this technique)";
+    msg << " (misspelt, or not used by " << reader << ")";
     throw Error(context_, msg.str());
 }
 

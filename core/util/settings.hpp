@@ -40,8 +40,8 @@ public:
 
     // Whether get or require has asked for `key` (present or not).
     bool was_read(const std::string& key) const { return read_.count(key) != 0; }
-    // Throws Error listing every key that was never read.
-    void report_unused() const;
+    // Throws Error listing every key that was never read, as not used by `reader`.
+    void report_unused(const std::string& reader = "this technique") const;
     const nlohmann::json& json() const { return values_; }
     const std::string& context() const { return context_; }
     // Stable hash of the settings (for provenance: identical settings ⇒ identical hash).

@@ -75,11 +75,9 @@ Run run_technique(const std::string& technique, const Scene& scene, const ViewSe
                   int frames) {
     Run run;
     run.peak_rss_exact = reset_peak_rss();
-    auto t = TechniqueRegistry::builtin().create(technique);
     Stopwatch prepare;
-    t->prepare(scene, settings);
+    auto t = prepare_technique(technique, scene, settings);
     run.prepare_ms = prepare.elapsed_ms();
-    settings.report_unused();
     std::vector<double> times;
     for (int f = 0; f < frames; ++f) {
         run.films.assign(views.views.size(), Film());

@@ -284,7 +284,7 @@ void prepare_render(TechniqueAndRig& setup, const RenderRequest& request, const 
     if (request.time_budget && !settings.was_read("time_budget"))
         throw Error("--time-budget", "technique '" + technique.name() +
                                          "' takes no time budget (it reads no setting 'time_budget'); leave --time-budget out");
-    settings.report_unused();
+    report_unused_settings(technique, settings);
 }
 
 std::vector<Film> render_films(TechniqueAndRig& setup, const RenderRequest& request, const Scene& scene,

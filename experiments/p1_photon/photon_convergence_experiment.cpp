@@ -82,10 +82,7 @@ double photon_pass_ms(const Stats& prepared) {
 // Renders one variant and measures it (see the file comment for what the time covers).
 Point measure(const Scene& scene, const EyeCamera& camera, const Film& reference, const std::string& technique,
               const json& settings_json) {
-    auto t = TechniqueRegistry::builtin().create(technique);
-    Settings settings(settings_json, "pm-convergence settings");
-    t->prepare(scene, settings);
-    settings.report_unused();
+    auto t = prepare_technique(technique, scene, Settings(settings_json, "pm-convergence settings"));
     const Stats prepared = t->stats();
     std::vector<Film> films;
     Stopwatch watch;

@@ -110,10 +110,7 @@ std::vector<Measured> measure(const Setup& setup, const ExperimentContext& ctx, 
     for (size_t v = 0; v < n; ++v) {
         variants[v]["seed"] = setup.seed;
         variants[v]["photon_storage"] = kStorage;
-        techniques.push_back(TechniqueRegistry::builtin().create("photon"));
-        Settings s(variants[v], "pm experiment settings");
-        techniques[v]->prepare(setup.scene, s);
-        s.report_unused();
+        techniques.push_back(prepare_technique("photon", setup.scene, Settings(variants[v], "pm experiment settings")));
         Stats prepared = techniques[v]->stats();
         results[v].trace_ms = prepared.get("photon_trace_ms");
         results[v].build_ms = prepared.get("photon_build_ms");

@@ -80,10 +80,8 @@ std::vector<Run> measure(const ExperimentContext& ctx, const Scene& scene, const
     for (size_t v = 0; v < n; ++v) {
         variants[v]["seed"] = ctx.seed;
         variants[v]["light_samples"] = kLightSamples;
-        techniques.push_back(TechniqueRegistry::builtin().create("photon"));
-        Settings s(variants[v], "pm stereo experiment settings");
-        techniques[v]->prepare(scene, s);
-        s.report_unused();
+        techniques.push_back(
+            prepare_technique("photon", scene, Settings(variants[v], "pm stereo experiment settings")));
     }
     const char* timed[] = {"render_ms", "left_ms", "right_ms", "claim_ms", "right_pass_ms"};
     std::vector<std::map<std::string, std::vector<double>>> samples(n);

@@ -470,14 +470,14 @@ ExperimentOutput run_table6(const ExperimentContext& ctx) {
     int color = 0;
     for (const OpenedDynamicScene& s : scenes) {
         try {
-            auto technique = TechniqueRegistry::builtin().create("dag_raycast");
-            technique->prepare(s.scene, Settings(json{{"resolution", resolution}, {"frames", frames}}, "dag-table6"));
+            auto technique = prepare_technique(
+                "dag_raycast", s.scene, Settings(json{{"resolution", resolution}, {"frames", frames}}, "dag-table6"));
             const Stats prepared = technique->stats();
             // The paper does not say whether its frame rates include shadows: the same DAG
             // with primary rays only is timed beside.
-            auto primary_only = TechniqueRegistry::builtin().create("dag_raycast");
-            primary_only->prepare(
-                s.scene, Settings(json{{"resolution", resolution}, {"frames", frames}, {"shadows", "none"}}, "dag-table6"));
+            auto primary_only = prepare_technique(
+                "dag_raycast", s.scene,
+                Settings(json{{"resolution", resolution}, {"frames", frames}, {"shadows", "none"}}, "dag-table6"));
             const SceneCamera c = s.scene.camera.value_or(default_camera_for(s.scene.evaluate(0).bounds));
             std::vector<Film> probe;  // which shadow source the light resolved to
             technique->render(ViewSet::mono(EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, 8, 6)),

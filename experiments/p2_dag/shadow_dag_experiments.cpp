@@ -407,9 +407,9 @@ ExperimentOutput run_fig16_18(const ExperimentContext& ctx) {
         std::vector<std::unique_ptr<Technique>> techniques;
         for (size_t vi = 0; vi < n_variants; ++vi) {
             const Variant& v = fig16_variants()[vi];
-            techniques.push_back(TechniqueRegistry::builtin().create("dag_shadows"));
-            techniques.back()->prepare(scene,
-                                       Settings(json{{"visibility", v.visibility}, {"resolution", res}}, "dag-fig16-18"));
+            techniques.push_back(prepare_technique("dag_shadows", scene,
+                                                   Settings(json{{"visibility", v.visibility}, {"resolution", res}},
+                                                            "dag-fig16-18")));
             bytes[vi] = techniques.back()->stats().get("structure_bytes");
             build_s[vi] = techniques.back()->stats().get("structure_build_ms") / 1000;
         }

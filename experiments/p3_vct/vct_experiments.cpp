@@ -564,11 +564,7 @@ std::unique_ptr<Technique> make_vct(const Scene& scene, nlohmann::json settings,
     settings["seed"] = ctx.seed;
     // Quick runs are smoke checks: half the paper's 16 voxel-bounce cones.
     if (ctx.quick && !settings.contains("injection_cones")) settings["injection_cones"] = 8;
-    auto t = TechniqueRegistry::builtin().create("vct");
-    Settings s(settings, "vct experiment settings");
-    t->prepare(scene, s);
-    s.report_unused();
-    return t;
+    return prepare_technique("vct", scene, Settings(settings, "vct experiment settings"));
 }
 
 void quick_note(const ExperimentContext& ctx, ExperimentOutput& out) {
@@ -761,12 +757,9 @@ const std::vector<CameraWalkRuns>& camera_walk_runs(const ExperimentContext& ctx
                 // inject light every frame, so each photon frame is charged that pass too.
                 CameraWalkRun run;
                 run.name = "photon mapping";
-                auto t = TechniqueRegistry::builtin().create("photon");
                 nlohmann::json settings = walk_photon_settings();
                 settings["seed"] = ctx.seed;
-                Settings s(settings, "vct-fig9 photon settings");
-                t->prepare(*scene, s);
-                s.report_unused();
+                auto t = prepare_technique("photon", *scene, Settings(settings, "vct-fig9 photon settings"));
                 const Stats prepared = t->stats();
                 const double photon_pass_ms = prepared.get("photon_trace_ms") + prepared.get("photon_build_ms");
                 for (const EyeCamera& cam : cams) {

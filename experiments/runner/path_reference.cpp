@@ -60,10 +60,7 @@ Film path_reference(const ExperimentContext& ctx, const Scene& scene, const EyeC
     }
     ctx.say("rendering the path-traced reference (" + std::to_string(camera.width()) + "², " + std::to_string(spp) +
             " spp) ...");
-    auto path = TechniqueRegistry::builtin().create("path");
-    Settings s(settings, "pm reference");
-    path->prepare(scene, s);
-    s.report_unused();
+    auto path = prepare_technique("path", scene, Settings(settings, "pm reference"));
     std::vector<Film> films;
     path->render(ViewSet::mono(camera), films);
     ctx.say("reference done in " + std::to_string(path->stats().get("render_ms") / 1000.0) + " s");

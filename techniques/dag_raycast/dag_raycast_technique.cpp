@@ -4,12 +4,12 @@
 #include <atomic>
 #include <cmath>
 #include "accel/dag/dag_ray_caster.hpp"
-#include "core/util/build_info.hpp"
 #include "core/util/error.hpp"
 #include "core/util/format.hpp"
 #include "core/util/parallel.hpp"
 #include "core/render/traced_scene.hpp"
 #include "techniques/dag_raycast/voxel_face.hpp"
+#include "techniques/film_provenance.hpp"
 
 namespace gilab {
 namespace {
@@ -223,20 +223,17 @@ void DagRaycastTechnique::render(const ViewSet& views, std::vector<Film>& films)
             rays += tile_rays;
             primary_visits += tile_visits;
         });
-        film.metadata["technique"] = kName;
-        film.metadata["view"] = v < views.names.size() ? views.names[v] : "mono";
+        write_film_provenance(film, kName, views, v, settings_.seed);
         film.metadata["frame"] = std::to_string(frame);
         film.metadata["frame_time"] = format_number(animation_.times[frame]);
         film.metadata["build"] = to_string(settings_.build);
         film.metadata["resolution"] = std::to_string(settings_.resolution);
         film.metadata["light"] = shading_light ? shading_light->name : "headlight";
         film.metadata["shadows"] = to_string(shadows_);
-        film.metadata["seed"] = std::to_string(settings_.seed);
-        film.metadata["git_revision"] = build_git_revision();
         films[v] = std::move(film);
     }
     const double ms = total.elapsed_ms();
-    for (Film& film : films) film.metadata["render_time_seconds"] = format_number(ms / 1000.0);
+    write_render_time(films, ms);
     stats_.set("render_ms", ms);
     stats_.set("rays", double(rays.load()));
     size_t pixels = 0;

@@ -1,10 +1,9 @@
 #include "techniques/dag_shadows/dag_shadows_technique.hpp"
 #include <cmath>
-#include "core/util/build_info.hpp"
 #include "core/util/error.hpp"
-#include "core/util/format.hpp"
 #include "core/render/interaction.hpp"
 #include "core/util/parallel.hpp"
+#include "techniques/film_provenance.hpp"
 
 namespace gilab {
 namespace {
@@ -253,16 +252,13 @@ void DagShadowsTechnique::render(const ViewSet& views, std::vector<Film>& films)
                 film.set("visibility", x, y, vis[k]);
             }
         });
-        film.metadata["technique"] = kName;
-        film.metadata["view"] = v < views.names.size() ? views.names[v] : "mono";
+        write_film_provenance(film, kName, views, v, settings_.seed);
         film.metadata["visibility"] = to_string(settings_.visibility);
         film.metadata["resolution"] = std::to_string(settings_.resolution);
-        film.metadata["seed"] = std::to_string(settings_.seed);
-        film.metadata["git_revision"] = build_git_revision();
         films[v] = std::move(film);
     }
     const double ms = total.elapsed_ms();
-    for (Film& film : films) film.metadata["render_time_seconds"] = format_number(ms / 1000.0);
+    write_render_time(films, ms);
     stats_.set("render_ms", ms);
     stats_.set("shadow_ms", shadow_ms);
     stats_.set("lookups", double(lookups));

@@ -3,13 +3,12 @@
 #include <atomic>
 #include <cmath>
 #include "core/render/bsdf.hpp"
-#include "core/util/build_info.hpp"
 #include "core/util/error.hpp"
-#include "core/util/format.hpp"
 #include "core/render/interaction.hpp"
 #include "core/util/parallel.hpp"
 #include "core/util/progress.hpp"
 #include "core/util/rng.hpp"
+#include "techniques/film_provenance.hpp"
 
 
 namespace gilab {
@@ -233,18 +232,14 @@ void PathTracer::render(const ViewSet& views, std::vector<Film>& films) {
         });
         progress.finish();
         samples += double(width) * double(height) * double(spp);
-        film.metadata["technique"] = "path";
-        film.metadata["view"] = v < views.names.size() ? views.names[v] : "mono";
+        write_film_provenance(film, name(), views, v, settings_.seed, config_hash_);
         film.metadata["spp"] = std::to_string(spp);
-        film.metadata["seed"] = std::to_string(settings_.seed);
         film.metadata["max_depth"] = std::to_string(settings_.max_depth);
         film.metadata["rr_depth"] = std::to_string(settings_.rr_depth);
-        film.metadata["config_hash"] = config_hash_;
-        film.metadata["git_revision"] = build_git_revision();
         films[v] = std::move(film);
     }
     double ms = watch.elapsed_ms();
-    for (Film& film : films) film.metadata["render_time_seconds"] = format_number(ms / 1000.0);
+    write_render_time(films, ms);
     stats_.set("render_ms", ms);
     stats_.set("rays", double(rays.load()));
     stats_.set("samples", samples);

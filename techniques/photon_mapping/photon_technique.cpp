@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include "core/util/build_info.hpp"
 #include "core/util/error.hpp"
 #include "core/util/format.hpp"
+#include "techniques/film_provenance.hpp"
 #include "techniques/photon_mapping/photon_passes.hpp"
 #include "techniques/photon_mapping/photon_tracer.hpp"
 
@@ -115,24 +115,20 @@ void PhotonMappingTechnique::render(const ViewSet& views, std::vector<Film>& fil
         }
         const double view_ms = view_watch.elapsed_ms();
         if (stereo) frame.set(v == 0 ? "left_ms" : "right_ms", view_ms);
-        film.metadata["technique"] = "photon";
-        film.metadata["view"] = v < views.names.size() ? views.names[v] : "mono";
+        write_film_provenance(film, name(), views, v, settings_.seed, config_hash_);
         film.metadata["photons"] = std::to_string(settings_.photons);
         film.metadata["radius"] = format_number(settings_.radius);
         film.metadata["gather"] = settings_.gather == GatherMode::Knn ? "knn" : "radius";
         film.metadata["photon_map"] = to_string(settings_.photon_map);
         film.metadata["photon_storage"] = to_string(settings_.storage);
         film.metadata["tile_shared"] = to_string(settings_.tile_shared);
-        film.metadata["seed"] = std::to_string(settings_.seed);
         film.metadata["spp"] = std::to_string(settings_.sampling.spp);
         film.metadata["jitter"] = settings_.sampling.jitter ? "true" : "false";
         if (stereo) film.metadata["stereo_reuse"] = reuse ? to_string(settings_.stereo.match) : "off";
-        film.metadata["config_hash"] = config_hash_;
-        film.metadata["git_revision"] = build_git_revision();
         films[v] = std::move(film);
     }
     double ms = watch.elapsed_ms();
-    for (Film& film : films) film.metadata["render_time_seconds"] = format_number(ms / 1000.0);
+    write_render_time(films, ms);
     // Per-frame figures replace the previous frame's. A figure this frame's path did not
     // produce (no stereo reuse, no tile sharing, ...) is work not done: 0 this frame.
     for (const char* key : {"fused_ms", "trace_pass_ms", "sort_ms", "gather_pass_ms", "nonfinite_pixels", "tile_groups",

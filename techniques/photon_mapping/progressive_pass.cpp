@@ -11,13 +11,13 @@
 #include <algorithm>
 #include <atomic>
 #include "core/render/bsdf.hpp"
-#include "core/util/build_info.hpp"
 #include "core/util/error.hpp"
 #include "core/util/format.hpp"
 #include "core/render/interaction.hpp"
 #include "core/util/parallel.hpp"
 #include "core/util/progress.hpp"
 #include "core/util/stats.hpp"
+#include "techniques/film_provenance.hpp"
 #include "techniques/photon_mapping/photon_passes.hpp"
 #include "techniques/photon_mapping/photon_tracer.hpp"
 
@@ -182,21 +182,17 @@ void PhotonMappingTechnique::render_progressive(const ViewSet& views, std::vecto
             // nothing about how far the radii shrank.
             if (view.pixels[i].count > 0) radius_sum += view.pixels[i].radius, ++radius_pixels;
         }
-        film.metadata["technique"] = "photon";
-        film.metadata["view"] = v < views.names.size() ? views.names[v] : "mono";
+        write_film_provenance(film, name(), views, v, s.seed, config_hash_);
         film.metadata["progressive"] = "true";
         film.metadata["iterations"] = std::to_string(done);
         film.metadata["alpha"] = format_number(g.alpha);
         film.metadata["photons"] = std::to_string(s.photons);
         film.metadata["radius"] = format_number(s.radius);
         film.metadata["photon_storage"] = to_string(s.storage);
-        film.metadata["seed"] = std::to_string(s.seed);
-        film.metadata["config_hash"] = config_hash_;
-        film.metadata["git_revision"] = build_git_revision();
         films[v] = std::move(film);
     }
     const double ms = watch.elapsed_ms();
-    for (Film& film : films) film.metadata["render_time_seconds"] = format_number(ms / 1000.0);
+    write_render_time(films, ms);
     stats_.set("render_ms", ms);
     stats_.set("iterations_run", double(done));
     stats_.set("iterations_requested", double(g.iterations));

@@ -3,7 +3,6 @@
 #include <atomic>
 #include <cmath>
 #include "core/render/bsdf.hpp"
-#include "core/util/build_info.hpp"
 #include "core/util/error.hpp"
 #include "core/util/format.hpp"
 #include "core/render/interaction.hpp"
@@ -11,6 +10,7 @@
 #include "core/util/progress.hpp"
 #include "core/util/rng.hpp"
 #include "core/voxel/voxel_grid.hpp"
+#include "techniques/film_provenance.hpp"
 
 
 namespace gilab {
@@ -683,13 +683,9 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
                 color.data[j] = direct.data[j] + indirect.data[j] + specular.data[j];
             }
 
-        film.metadata["technique"] = "vct";
+        write_film_provenance(film, name(), views, vi, settings_.seed, config_hash_);
         film.metadata["structure"] = settings_.structure == VctSettings::Structure::Dense ? "dense" : "cascaded";
-        film.metadata["view"] = vi < views.names.size() ? views.names[vi] : "mono";
-        film.metadata["seed"] = std::to_string(settings_.seed);
         film.metadata["frame"] = std::to_string(frame_index_);
-        film.metadata["config_hash"] = config_hash_;
-        film.metadata["git_revision"] = build_git_revision();
         films[vi] = std::move(film);
     }
     const double update_ms = stats_.get("update_ms"), injection_ms = stats_.get("injection_ms");
@@ -709,7 +705,7 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
     }
     const double ms = total_watch.elapsed_ms();
     stats_.set("render_ms", ms);
-    for (Film& film : films) film.metadata["render_time_seconds"] = format_number(ms / 1000.0);
+    write_render_time(films, ms);
 }
 
 void register_vct(TechniqueRegistry& registry) {

@@ -82,10 +82,7 @@ double relmse_bound(const std::string& technique, const std::string& scene) {
 }
 
 Film render(const std::string& technique, const Scene& scene, const EyeCamera& camera, const json& settings_json) {
-    auto t = TechniqueRegistry::builtin().create(technique);
-    Settings settings(settings_json, technique + " settings");
-    t->prepare(scene, settings);
-    settings.report_unused();
+    auto t = prepare_technique(technique, scene, Settings(settings_json, technique + " settings"));
     std::vector<Film> films;
     t->render(ViewSet::mono(camera), films);
     return std::move(films.at(0));

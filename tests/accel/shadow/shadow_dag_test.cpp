@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 #include <random>
+#include <vector>
 #include "accel/dag/dag_layout.hpp"
 #include "accel/shadow/light_shadow_dags.hpp"
 #include "accel/shadow/shadow_dag.hpp"
@@ -12,6 +13,7 @@
 #include "core/util/parallel.hpp"
 #include "core/render/ray_tracer.hpp"
 #include "core/scene/scene.hpp"
+#include "scenes/procedural_meshes.hpp"
 #include "scenes/villa_and_terrain.hpp"
 #include "tests/test_support.hpp"
 
@@ -295,17 +297,13 @@ TEST(DagLayout, CanonicalOrderIgnoresInsertionOrder) {
 
 namespace {
 
+// A box (make_box), or an open one without its top face (y = hi.y).
 Mesh box_mesh(const Vec3& lo, const Vec3& hi, bool closed = true) {
-    Mesh m;
-    m.name = "box";
-    for (int i = 0; i < 8; ++i) m.positions.push_back(Vec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z));
-    // Outward winding (counter-clockwise seen from outside).
-    const uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-    for (int f = 0; f < 6; ++f) {
-        if (!closed && f == 3) continue;  // open box: no top
-        m.triangles.push_back(UVec3(q[f][0], q[f][1], q[f][2]));
-        m.triangles.push_back(UVec3(q[f][0], q[f][2], q[f][3]));
-    }
+    Mesh m = make_box("box", lo, hi, 0);
+    if (closed) return m;
+    std::erase_if(m.triangles, [&](const UVec3& t) {
+        return m.positions[t.x].y == hi.y && m.positions[t.y].y == hi.y && m.positions[t.z].y == hi.y;
+    });
     m.material_ids.assign(m.triangles.size(), 0);
     return m;
 }

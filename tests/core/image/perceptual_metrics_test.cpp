@@ -245,14 +245,25 @@ TEST(PerceptualMetrics, ExposureAndClampingFollowThePngPreview) {
 
 // ------------------------------------------------------------------ HDR-FLIP
 
-// The published matrices are each other's inverse to the digits they give.
+// The library converts with the FLIP papers' matrices (to_xyz and from_xyz above), and
+// the published matrices are each other's inverse to the digits they give.
 TEST(PerceptualMetrics, FlipColourMatricesAreTheFlipPapers) {
-    const Triple white = to_xyz({1, 1, 1});
+    for (int j = 0; j < 3; ++j) {  // column j: the image of the j-th unit vector
+        Triple unit{0, 0, 0};
+        unit[size_t(j)] = 1;
+        const Triple forward = flip_rgb_to_xyz(unit), paper_forward = to_xyz(unit);
+        const Triple inverse = flip_xyz_to_rgb(unit), paper_inverse = from_xyz(unit);
+        for (int i = 0; i < 3; ++i) {
+            EXPECT_DOUBLE_EQ(forward[size_t(i)], paper_forward[size_t(i)]) << "rgb → xyz row " << i << " column " << j;
+            EXPECT_DOUBLE_EQ(inverse[size_t(i)], paper_inverse[size_t(i)]) << "xyz → rgb row " << i << " column " << j;
+        }
+    }
+    const Triple white = flip_rgb_to_xyz({1, 1, 1});
     EXPECT_NEAR(white[0], 0.950428545, 1e-9);  // the D65 white the FLIP code states
     EXPECT_NEAR(white[1], 1.0, 1e-12);
     EXPECT_NEAR(white[2], 1.088900371, 1e-9);
     for (const Triple& c : {Triple{1, 0, 0}, Triple{0, 1, 0}, Triple{0.2, 0.5, 0.9}}) {
-        const Triple back = from_xyz(to_xyz(c));
+        const Triple back = flip_xyz_to_rgb(flip_rgb_to_xyz(c));
         for (int k = 0; k < 3; ++k) EXPECT_NEAR(back[size_t(k)], c[size_t(k)], 1e-7);
     }
 }

@@ -3,40 +3,37 @@
 // crashing, and the real Cornell box is open.
 #include <gtest/gtest.h>
 #include <algorithm>
+#include <map>
 #include <numeric>
 #include <random>
 
 #include "core/io/mesh_loaders.hpp"
 #include "core/scene/mesh_topology.hpp"
+#include "scenes/procedural_meshes.hpp"
 #include "tests/test_support.hpp"
 
 using namespace gilab;
 
 namespace {
 
-// Unit cube, 8 shared vertices, 12 outward-facing triangles (two per face).
-Mesh cube(Vec3 offset = Vec3(0)) {
-    Mesh m;
-    m.name = "cube";
-    for (int i = 0; i < 8; ++i) m.positions.push_back(offset + Vec3(i & 1, (i >> 1) & 1, (i >> 2) & 1));
-    const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-    for (const auto& q : quads) {
-        m.triangles.emplace_back(q[0], q[1], q[2]);
-        m.triangles.emplace_back(q[0], q[2], q[3]);
-    }
-    m.material_ids.assign(m.triangles.size(), 0);
-    return m;
-}
+// Unit cube, 8 shared vertices, 12 outward-facing triangles, two per face in the order
+// x = 0, x = 1, y = 0, y = 1, z = 0, z = 1.
+Mesh cube(Vec3 offset = Vec3(0)) { return make_box("cube", offset, offset + Vec3(1), 0); }
 
-// The same cube with 4 vertices per face (as exporters write it for flat normals).
+// The same cube with 4 vertices per face (as exporters write it for flat normals): each
+// face's two triangles get copies of its corners of their own.
 Mesh split_cube() {
     Mesh c = cube(), out;
     for (size_t f = 0; f < 6; ++f) {
-        const uint32_t base = uint32_t(out.positions.size());
-        const UVec3 a = c.triangles[2 * f], b = c.triangles[2 * f + 1];
-        for (uint32_t v : {a.x, a.y, a.z, b.z}) out.positions.push_back(c.positions[v]);
-        out.triangles.emplace_back(base, base + 1, base + 2);
-        out.triangles.emplace_back(base, base + 2, base + 3);
+        std::map<uint32_t, uint32_t> copy;  // the face's corners in c → in out
+        for (UVec3 t : {c.triangles[2 * f], c.triangles[2 * f + 1]}) {
+            for (int k = 0; k < 3; ++k) {
+                const auto [it, added] = copy.try_emplace(t[k], uint32_t(out.positions.size()));
+                if (added) out.positions.push_back(c.positions[t[k]]);
+                t[k] = it->second;
+            }
+            out.triangles.push_back(t);
+        }
     }
     out.material_ids.assign(out.triangles.size(), 0);
     return out;

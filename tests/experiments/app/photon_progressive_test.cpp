@@ -26,10 +26,7 @@ using nlohmann::json;
 
 std::vector<Film> render_views(const std::string& technique, const Scene& scene, const ViewSet& views,
                                const json& settings_json, Stats* stats = nullptr) {
-    auto t = TechniqueRegistry::builtin().create(technique);
-    Settings settings(settings_json, "test settings");
-    t->prepare(scene, settings);
-    settings.report_unused();
+    auto t = prepare_technique(technique, scene, Settings(settings_json, "test settings"));
     std::vector<Film> films;
     t->render(views, films);
     if (stats) *stats = t->stats();

@@ -27,11 +27,7 @@ EyeCamera scene_camera(const Scene& scene, int w, int h) {
 }
 
 std::unique_ptr<Technique> prepared(const Scene& scene, const json& settings) {
-    auto t = TechniqueRegistry::builtin().create("dag_raycast");
-    Settings s(settings, "test");
-    t->prepare(scene, s);
-    s.report_unused();
-    return t;
+    return prepare_technique("dag_raycast", scene, Settings(settings, "test"));
 }
 
 Film render(Technique& t, const EyeCamera& camera) {
@@ -105,8 +101,7 @@ TEST(DagRaycast, DepthAgreesWithPathTracerOnStaticScene) {
     auto dag = prepared(cornell, {{"resolution", 128}, {"seed", 3}});
     EXPECT_EQ(dag->stats().get("frames"), 1.0);
     const Film voxels = render(*dag, camera);
-    auto path = TechniqueRegistry::builtin().create("path");
-    path->prepare(cornell, Settings(json{{"spp", 1}, {"jitter", false}, {"max_depth", 0}}));
+    auto path = prepare_technique("path", cornell, Settings(json{{"spp", 1}, {"jitter", false}, {"max_depth", 0}}));
     std::vector<Film> truth;
     path->render(ViewSet::mono(camera), truth);
 

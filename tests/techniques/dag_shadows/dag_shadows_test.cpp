@@ -19,10 +19,8 @@ EyeCamera villa_camera(const Scene& scene, int w = 96, int h = 72) {
 
 std::vector<Film> render(const Scene& scene, const std::string& visibility, uint32_t resolution = 512,
                          int pcf = 1) {
-    auto t = TechniqueRegistry::builtin().create("dag_shadows");
-    Settings s(json{{"visibility", visibility}, {"resolution", resolution}, {"pcf", pcf}}, "test");
-    t->prepare(scene, s);
-    s.report_unused();
+    const Settings s(json{{"visibility", visibility}, {"resolution", resolution}, {"pcf", pcf}}, "test");
+    auto t = prepare_technique("dag_shadows", scene, s);
     std::vector<Film> films;
     t->render(ViewSet::mono(villa_camera(scene)), films);
     EXPECT_GE(t->stats().get("shadow_ms"), 0);
@@ -74,8 +72,8 @@ TEST(DagShadows, ColorIsDirectLightTimesVisibilityPlusAmbient) {
 
 TEST(DagShadows, StereoAndThreadCountsGiveTheSameImages) {
     const Scene villa = make_villa();
-    auto t = TechniqueRegistry::builtin().create("dag_shadows");
-    t->prepare(villa, Settings(json{{"visibility", "shadow_dag_double_depth"}, {"resolution", 256}, {"pcf", 3}}));
+    const Settings s(json{{"visibility", "shadow_dag_double_depth"}, {"resolution", 256}, {"pcf", 3}});
+    auto t = prepare_technique("dag_shadows", villa, s);
     const EyeCamera cam = villa_camera(villa);
     const EyeCamera right = EyeCamera(cam.position() + Vec3(0.5f, 0, 0), cam.orientation(), cam.fov(), 96, 72);
     std::vector<Film> one, two;

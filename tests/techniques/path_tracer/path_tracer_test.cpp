@@ -11,16 +11,14 @@
 #include "scenes/builtin_scenes.hpp"
 #include "techniques/path_tracer/path_tracer.hpp"
 #include "techniques/technique.hpp"
+#include "tests/test_support.hpp"
 
 namespace gilab {
 namespace {
 
 Film render(const Scene& scene, const EyeCamera& camera, nlohmann::json settings_json,
             Stats* stats = nullptr) {
-    auto technique = TechniqueRegistry::builtin().create("path");
-    Settings settings(std::move(settings_json), "test settings");
-    technique->prepare(scene, settings);
-    settings.report_unused();
+    auto technique = prepare_technique("path", scene, Settings(std::move(settings_json), "test settings"));
     std::vector<Film> films;
     technique->render(ViewSet::mono(camera), films);
     if (stats) *stats = technique->stats();
@@ -270,9 +268,7 @@ TEST(PathTracer, UpdateMovesAnimatedGeometry) {
     ASSERT_TRUE(scene.is_animated());
 
     EyeCamera camera = plane_camera();
-    auto technique = TechniqueRegistry::builtin().create("path");
-    Settings settings(nlohmann::json{{"spp", 1}, {"jitter", false}});
-    technique->prepare(scene, settings);
+    auto technique = prepare_technique("path", scene, Settings(nlohmann::json{{"spp", 1}, {"jitter", false}}));
     technique->update(1.0);
     std::vector<Film> films;
     technique->render(ViewSet::mono(camera), films);
@@ -357,8 +353,7 @@ TEST(PathTracer, CornellBoxLayersAreConsistent) {
 TEST(PathTracer, StereoPairRendersBothViews) {
     Scene scene = make_cornell_box();
     EyeCamera left = cornell_camera(scene, 16, 12);
-    auto technique = TechniqueRegistry::builtin().create("path");
-    technique->prepare(scene, Settings(nlohmann::json{{"spp", 1}}));
+    auto technique = prepare_technique("path", scene, Settings(nlohmann::json{{"spp", 1}}));
     std::vector<Film> films;
     technique->render(ViewSet::stereo_pair(left, left), films);
     ASSERT_EQ(films.size(), 2u);
@@ -386,6 +381,20 @@ TEST(PathTracer, MisspeltSettingIsReported) {
                                  {"jitter", true}});
     technique->prepare(scene, good);
     EXPECT_NO_THROW(good.report_unused());
+}
+
+// prepare_technique creates, prepares and reports the keys never read: its error names
+// the settings' context, the key and the technique.
+TEST(PathTracer, PrepareTechniqueReportsUnreadKeys) {
+    const Scene scene = make_cornell_box();
+    EXPECT_NO_THROW(prepare_technique("path", scene, Settings(nlohmann::json{{"spp", 1}})));
+    const std::string unread = test::error_of(
+        [&] { prepare_technique("path", scene, Settings(nlohmann::json{{"sp", 4}, {"seed", 2}}, "path settings")); });
+    EXPECT_NE(unread.find("path settings: unknown setting 'sp'"), std::string::npos) << unread;
+    EXPECT_NE(unread.find("technique 'path'"), std::string::npos) << unread;
+    EXPECT_EQ(unread.find("seed"), std::string::npos) << unread;
+    const std::string unknown = test::error_of([&] { prepare_technique("paht", scene, Settings()); });
+    EXPECT_NE(unknown.find("unknown technique"), std::string::npos) << unknown;
 }
 
 TEST(PathTracer, BadSettingValuesAreErrors) {

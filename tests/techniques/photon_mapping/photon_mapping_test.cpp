@@ -14,6 +14,7 @@
 #include "core/image/image_metrics.hpp"
 #include "core/util/parallel.hpp"
 #include "scenes/builtin_scenes.hpp"
+#include "scenes/procedural_meshes.hpp"
 #include "techniques/photon_mapping/photon_technique.hpp"
 #include "techniques/photon_mapping/photon_tracer.hpp"
 #include "techniques/photon_mapping/tile_share.hpp"
@@ -24,10 +25,7 @@ namespace {
 
 Film render(const std::string& technique, const Scene& scene, const EyeCamera& camera, nlohmann::json settings_json,
             Stats* stats = nullptr) {
-    auto t = TechniqueRegistry::builtin().create(technique);
-    Settings settings(std::move(settings_json), "test settings");
-    t->prepare(scene, settings);
-    settings.report_unused();
+    auto t = prepare_technique(technique, scene, Settings(std::move(settings_json), "test settings"));
     std::vector<Film> films;
     t->render(ViewSet::mono(camera), films);
     if (stats) *stats = t->stats();
@@ -366,9 +364,8 @@ TEST(PhotonMapping, EveryHitStoresACopyAtTheFirstHit) {
     // adds one copy per photon that reached a surface. Counted independently by tracing
     // the same photons to their first hit only; in a closed sphere every photon hits.
     auto prepared = [](const Scene& scene, const std::string& storage) {
-        auto t = TechniqueRegistry::builtin().create("photon");
-        t->prepare(scene, Settings(nlohmann::json{{"photons", 20000}, {"seed", 4}, {"photon_storage", storage}}));
-        return t;
+        const Settings s(nlohmann::json{{"photons", 20000}, {"seed", 4}, {"photon_storage", storage}});
+        return prepare_technique("photon", scene, s);
     };
     auto first_hits = [](const Scene& scene) {
         SceneFrame frame = scene.evaluate(0);
@@ -476,16 +473,7 @@ Scene black_box_with_point_light() {
     Material black;
     black.albedo = Vec3(0.0f);
     scene.materials.push_back(black);
-    Mesh mesh;
-    mesh.name = "cube";
-    for (int i = 0; i < 8; ++i) mesh.positions.push_back(Vec3(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1));
-    const uint32_t quads[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
-    for (const auto& q : quads) {
-        mesh.triangles.push_back({q[0], q[1], q[2]});
-        mesh.triangles.push_back({q[0], q[2], q[3]});
-    }
-    mesh.material_ids.assign(mesh.triangles.size(), 0);
-    scene.add_mesh_instance(std::move(mesh));
+    scene.add_mesh_instance(make_box("cube", Vec3(-1), Vec3(1), 0));
     PunctualLight light;
     light.position = Vec3(0.2f, 0.3f, 0.1f);
     light.intensity = Vec3(5.0f);

@@ -44,9 +44,7 @@ nlohmann::json every_hit(nlohmann::json base) {
 std::vector<Film> render_views(const Scene& scene, const ViewSet& views, const nlohmann::json& settings_json,
                                Stats* stats = nullptr) {
     PhotonMappingTechnique t;
-    Settings settings(settings_json, "test settings");
-    t.prepare(scene, settings);
-    settings.report_unused();
+    prepare_technique(t, scene, Settings(settings_json, "test settings"));
     std::vector<Film> films;
     t.render(views, films);
     if (stats) *stats = t.stats();
@@ -112,7 +110,7 @@ struct ExpectedImage {
 
 ExpectedImage expected_image(const Scene& scene, const EyeCamera& camera, const nlohmann::json& settings_json) {
     PhotonMappingTechnique t;
-    t.prepare(scene, Settings(settings_json));
+    prepare_technique(t, scene, Settings(settings_json));
     const PhotonMappingSettings& s = t.settings();
     const SceneFrame frame = scene.evaluate(0);
     const RayTracer tracer(frame);
@@ -303,8 +301,7 @@ TEST(PhotonSpp, JitteredSamplesLowerTheErrorAtEdges) {
     const EyeCamera camera = cornell_camera(scene, size);
     Film reference;
     {
-        auto path = TechniqueRegistry::builtin().create("path");
-        path->prepare(scene, Settings(nlohmann::json{{"spp", 1024}, {"seed", 9}}));
+        auto path = prepare_technique("path", scene, Settings(nlohmann::json{{"spp", 1024}, {"seed", 9}}));
         std::vector<Film> films;
         path->render(ViewSet::mono(camera), films);
         reference = films.at(0);

@@ -42,9 +42,7 @@ nlohmann::json every_hit(nlohmann::json base) {
 std::vector<Film> render_views(const Scene& scene, const ViewSet& views, const nlohmann::json& settings_json,
                                Stats* stats = nullptr) {
     PhotonMappingTechnique t;
-    Settings settings(settings_json, "test settings");
-    t.prepare(scene, settings);
-    settings.report_unused();
+    prepare_technique(t, scene, Settings(settings_json, "test settings"));
     std::vector<Film> films;
     t.render(views, films);
     if (stats) *stats = t.stats();

@@ -22,9 +22,7 @@ namespace {
 
 std::unique_ptr<VctTechnique> prepared(const Scene& scene, nlohmann::json settings_json) {
     auto t = std::make_unique<VctTechnique>();
-    Settings settings(std::move(settings_json), "test settings");
-    t->prepare(scene, settings);
-    settings.report_unused();
+    prepare_technique(*t, scene, Settings(std::move(settings_json), "test settings"));
     return t;
 }
 
@@ -210,9 +208,8 @@ TEST(ConeTracer, EmptySpaceGivesNothingAndAWallSaturates) {
 TEST(VctTechnique, CornellIndirectEnergyNearThePathTracer) {
     Scene scene = make_cornell_box();
     EyeCamera camera = inside_camera(48);
-    auto path = TechniqueRegistry::builtin().create("path");
-    Settings ps(nlohmann::json{{"spp", 256}, {"max_depth", 3}, {"seed", 3}}, "reference");
-    path->prepare(scene, ps);
+    const Settings ps(nlohmann::json{{"spp", 256}, {"max_depth", 3}, {"seed", 3}}, "reference");
+    auto path = prepare_technique("path", scene, ps);
     std::vector<Film> ref;
     path->render(ViewSet::mono(camera), ref);
 
