@@ -10,11 +10,15 @@
 //
 // Each concrete structure also has inline template versions of both queries
 // (for_each_in_radius, knn) for hot loops; the virtual ones here wrap them.
+//
+// The map owns its gather radius: build() records the radius the structure was built
+// for (the hash grid's cells are sized by it) and radius() gives it to the gather.
 #include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 #include "accel/photon/photon.hpp"
 
@@ -111,9 +115,18 @@ public:
     virtual PhotonMapKind kind() const = 0;
     std::string name() const { return to_string(kind()); }
 
-    // Replaces the content. `radius` is the gather radius the structure is tuned for
-    // (the hash grid's cell edge; ignored by the trees). Throws Error on bad input.
-    virtual void build(std::vector<Photon> photons, float radius) = 0;
+    // Replaces the content, built for the gather radius `radius`, which radius() then
+    // returns. The hash grid's cell edge derives from it (it must be positive and finite);
+    // the trees do not depend on it, and 0 (the default) suits a tree queried only at
+    // radii of its own. Throws Error on bad input; radius() changes only with a build
+    // that succeeds.
+    void build(std::vector<Photon> photons, float radius = 0) {
+        build_structure(std::move(photons), radius);
+        radius_ = radius;
+    }
+    // The gather radius of the last build (0 before the first).
+    float radius() const { return radius_; }
+
     virtual size_t size() const = 0;
     bool empty() const { return size() == 0; }
     virtual const Photon& photon(uint32_t index) const = 0;
@@ -127,6 +140,13 @@ public:
     // within max_r of x.
     virtual void knn_query(const Vec3& x, size_t k, float max_r, NeighborHeap& heap,
                            PhotonQueryStats& stats) const = 0;
+
+protected:
+    // The structure's part of build().
+    virtual void build_structure(std::vector<Photon> photons, float radius) = 0;
+
+private:
+    float radius_ = 0;
 };
 
 std::unique_ptr<PhotonMap> make_photon_map(PhotonMapKind kind);
