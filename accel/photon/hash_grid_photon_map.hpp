@@ -26,8 +26,9 @@ HashQuery parse_hash_query(const std::string& name, const std::string& where);
 
 class HashGridPhotonMap final : public PhotonMap {
 public:
+    static constexpr PhotonMapKind kKind = PhotonMapKind::HashGrid;
     explicit HashGridPhotonMap(HashQuery mode = HashQuery::Runs9) : mode_(mode) {}
-    PhotonMapKind kind() const override { return PhotonMapKind::HashGrid; }
+    PhotonMapKind kind() const override { return kKind; }
     size_t size() const override { return photons_.size(); }
     const Photon& photon(uint32_t index) const override { return photons_[index]; }
     uint32_t original_index(uint32_t index) const override { return original_[index]; }

@@ -11,7 +11,8 @@ namespace gilab {
 
 class KdTreePhotonMap final : public PhotonMap {
 public:
-    PhotonMapKind kind() const override { return PhotonMapKind::KdTree; }
+    static constexpr PhotonMapKind kKind = PhotonMapKind::KdTree;
+    PhotonMapKind kind() const override { return kKind; }
     size_t size() const override { return nodes_.size(); }
     const Photon& photon(uint32_t index) const override { return nodes_[index]; }
     uint32_t original_index(uint32_t index) const override { return original_[index]; }

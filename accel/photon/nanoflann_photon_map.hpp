@@ -13,7 +13,8 @@ class NanoflannPhotonMap final : public PhotonMap {
 public:
     explicit NanoflannPhotonMap(size_t leaf_max_size = 10);
     ~NanoflannPhotonMap() override;
-    PhotonMapKind kind() const override { return PhotonMapKind::Nanoflann; }
+    static constexpr PhotonMapKind kKind = PhotonMapKind::Nanoflann;
+    PhotonMapKind kind() const override { return kKind; }
     size_t size() const override { return photons_.size(); }
     const Photon& photon(uint32_t index) const override { return photons_[index]; }
     uint32_t original_index(uint32_t index) const override { return index; }

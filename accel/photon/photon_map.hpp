@@ -9,7 +9,8 @@
 // storage order (photon(i)); original_index(i) maps back to the build input.
 //
 // Each concrete structure also has inline template versions of both queries
-// (for_each_in_radius, knn) for hot loops; the virtual ones here wrap them.
+// (for_each_in_radius, knn) for hot loops; the virtual ones here wrap them. A hot loop
+// reaches them through as<Map>(), which names the concrete structure by its kind.
 //
 // The map owns its gather radius: build() records the radius the structure was built
 // for (the hash grid's cells are sized by it) and radius() gives it to the gather.
@@ -114,6 +115,18 @@ public:
     virtual ~PhotonMap() = default;
     virtual PhotonMapKind kind() const = 0;
     std::string name() const { return to_string(kind()); }
+
+    // The concrete structure (HashGridPhotonMap, KdTreePhotonMap, NanoflannPhotonMap) if
+    // this map is one, else null. Each is final and the only map of its kind (Map::kKind).
+    template <typename Map>
+    const Map* as() const {
+        static_assert(std::is_base_of_v<PhotonMap, Map> && std::is_final_v<Map>, "a concrete photon map");
+        return kind() == Map::kKind ? static_cast<const Map*>(this) : nullptr;
+    }
+    template <typename Map>
+    Map* as() {
+        return const_cast<Map*>(std::as_const(*this).template as<Map>());
+    }
 
     // Replaces the content, built for the gather radius `radius`, which radius() then
     // returns. The hash grid's cell edge derives from it (it must be positive and finite);

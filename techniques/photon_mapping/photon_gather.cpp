@@ -101,9 +101,11 @@ PhotonGatherer::PhotonGatherer(const PhotonMap& map, const std::vector<Material>
       inv_area_(1.0f / (kPi * radius_ * radius_)), k_(k) {
     if (!(radius_ > 0.0f))
         throw Error("photon gather", "the photon map's radius must be positive (build the map with the gather radius)");
-    grid_ = dynamic_cast<const HashGridPhotonMap*>(&map);
-    kd_ = dynamic_cast<const KdTreePhotonMap*>(&map);
-    nano_ = dynamic_cast<const NanoflannPhotonMap*>(&map);
+    // The fast paths (null for the other kinds): the grid's runs, the kd-tree's inline
+    // queries, nanoflann's filtered kNN.
+    grid_ = map.as<HashGridPhotonMap>();
+    kd_ = map.as<KdTreePhotonMap>();
+    nano_ = map.as<NanoflannPhotonMap>();
     if (!grid_) {  // the trees' sort keys use r-sized cells from the photons' minimum
         Bounds3 box;
         for (uint32_t i = 0; i < map.size(); ++i) box.extend(map.photon(i).position);

@@ -1,5 +1,6 @@
 // The photon-map front end: every structure keeps the gather radius it was built for
-// (a failed build leaves it as it was).
+// (a failed build leaves it as it was), and as<Map>() gives the concrete structure of
+// the map's kind and null for the others.
 #include <gtest/gtest.h>
 
 #include "accel/photon/hash_grid_photon_map.hpp"
@@ -29,6 +30,26 @@ TEST(PhotonMap, KeepsTheRadiusItWasBuiltFor) {
     KdTreePhotonMap tree;
     tree.build(photons);
     EXPECT_EQ(tree.radius(), 0.0f);
+}
+
+TEST(PhotonMap, AsGivesTheStructureOfItsKindOnly) {
+    auto grid = make_photon_map(PhotonMapKind::HashGrid);
+    auto tree = make_photon_map(PhotonMapKind::KdTree);
+    auto nano = make_photon_map(PhotonMapKind::Nanoflann);
+    EXPECT_EQ(grid->as<HashGridPhotonMap>(), grid.get());
+    EXPECT_EQ(tree->as<KdTreePhotonMap>(), tree.get());
+    EXPECT_EQ(nano->as<NanoflannPhotonMap>(), nano.get());
+    EXPECT_EQ(grid->as<KdTreePhotonMap>(), nullptr);
+    EXPECT_EQ(grid->as<NanoflannPhotonMap>(), nullptr);
+    EXPECT_EQ(tree->as<HashGridPhotonMap>(), nullptr);
+    EXPECT_EQ(tree->as<NanoflannPhotonMap>(), nullptr);
+    EXPECT_EQ(nano->as<HashGridPhotonMap>(), nullptr);
+    EXPECT_EQ(nano->as<KdTreePhotonMap>(), nullptr);
+    const PhotonMap& view = *grid;
+    const HashGridPhotonMap* typed = view.as<HashGridPhotonMap>();
+    EXPECT_EQ(typed, grid.get());
+    grid->as<HashGridPhotonMap>()->set_query_mode(HashQuery::Cells27);
+    EXPECT_EQ(typed->query_mode(), HashQuery::Cells27);
 }
 
 }  // namespace
