@@ -97,7 +97,7 @@ void BM_Gather(benchmark::State& state) {
     const float r = kRadii[state.range(0)];
     const PhotonMap& map = structure(Kind, r);
     const auto& f = fixture();
-    PhotonGatherer gatherer(map, f.scene.materials, GatherMode::Radius, r, 128);
+    PhotonGatherer gatherer(map, f.scene.materials, GatherMode::Radius, 128);
     GatherScratch scratch;
     PhotonQueryStats stats;
     for (auto _ : state) {

@@ -17,7 +17,6 @@ namespace {
 
 struct PythonPhotonMap {
     std::unique_ptr<PhotonMap> map;
-    float radius = 0;
     PhotonQueryStats stats;  // summed over every query made through Python
 };
 
@@ -90,16 +89,16 @@ same for every kind: a radius query returns the same indices from each.
 )doc")
         .def(py::init([](const py::object& positions, float radius, const std::string& kind, const py::object& powers) {
                  auto pm = std::make_unique<PythonPhotonMap>();
-                 pm->radius = radius_from(radius, "radius");
+                 radius_from(radius, "radius");
                  pm->map = make_photon_map(parse_photon_map_kind(kind, "kind"));
                  std::vector<Photon> photons = photons_from(positions, powers);
                  py::gil_scoped_release release;
-                 pm->map->build(std::move(photons), pm->radius);
+                 pm->map->build(std::move(photons), radius);
                  return pm;
              }),
              "positions"_a, "radius"_a = 0.05f, "kind"_a = "hash_grid", "powers"_a = py::none())
         .def_property_readonly("kind", [](const PythonPhotonMap& pm) { return pm.map->name(); })
-        .def_readonly("radius", &PythonPhotonMap::radius)
+        .def_property_readonly("radius", [](const PythonPhotonMap& pm) { return pm.map->radius(); })
         .def("__len__", [](const PythonPhotonMap& pm) { return pm.map->size(); })
         .def_property_readonly("memory_bytes", [](const PythonPhotonMap& pm) { return pm.map->memory_bytes(); })
         .def(

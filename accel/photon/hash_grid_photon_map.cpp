@@ -26,7 +26,7 @@ glm::ivec3 HashGridPhotonMap::cell_of(const Vec3& x) const {
     return c;
 }
 
-void HashGridPhotonMap::build(std::vector<Photon> photons, float radius) {
+void HashGridPhotonMap::build_structure(std::vector<Photon> photons, float radius) {
     const char* where = "photon hash grid";
     if (!(radius > 0.0f) || !std::isfinite(radius)) {
         std::ostringstream m;
@@ -40,7 +40,6 @@ void HashGridPhotonMap::build(std::vector<Photon> photons, float radius) {
             throw Error(where, "photon " + std::to_string(i) + " has a non-finite position");
         box.extend(photons[i].position);
     }
-    radius_ = radius;
     cell_ = radius * (1.0f + 0x1p-16f);
     inv_cell_ = 1.0 / double(cell_);
     start_.clear();

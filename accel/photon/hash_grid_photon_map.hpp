@@ -26,11 +26,9 @@ HashQuery parse_hash_query(const std::string& name, const std::string& where);
 
 class HashGridPhotonMap final : public PhotonMap {
 public:
+    static constexpr PhotonMapKind kKind = PhotonMapKind::HashGrid;
     explicit HashGridPhotonMap(HashQuery mode = HashQuery::Runs9) : mode_(mode) {}
-    PhotonMapKind kind() const override { return PhotonMapKind::HashGrid; }
-    // Throws Error if r is not positive and finite, or the grid would need more than
-    // max_cells cells (r far too small for the photons' extent).
-    void build(std::vector<Photon> photons, float radius) override;
+    PhotonMapKind kind() const override { return kKind; }
     size_t size() const override { return photons_.size(); }
     const Photon& photon(uint32_t index) const override { return photons_[index]; }
     uint32_t original_index(uint32_t index) const override { return original_[index]; }
@@ -45,7 +43,6 @@ public:
 
     HashQuery query_mode() const { return mode_; }
     void set_query_mode(HashQuery mode) { mode_ = mode; }
-    float radius() const { return radius_; }
     float cell_size() const { return cell_; }
     const Vec3& origin() const { return origin_; }
     const glm::ivec3& grid_size() const { return size_; }
@@ -129,6 +126,11 @@ public:
         }, stats);
     }
 
+protected:
+    // Throws Error if r is not positive and finite, or the grid would need more than
+    // max_cells cells (r far too small for the photons' extent).
+    void build_structure(std::vector<Photon> photons, float radius) override;
+
 private:
     bool interior(const glm::ivec3& c) const {
         return c.x >= 1 && c.y >= 1 && c.z >= 1 && c.x <= size_.x - 2 && c.y <= size_.y - 2 && c.z <= size_.z - 2;
@@ -162,7 +164,7 @@ private:
     }
 
     HashQuery mode_;
-    float radius_ = 0, cell_ = 0;
+    float cell_ = 0;
     double inv_cell_ = 0;
     Vec3 origin_{0};
     glm::ivec3 size_{0};

@@ -17,7 +17,7 @@ size_t left_balanced_left_size(size_t n) {
     return (half - 1) + std::min(last, half);
 }
 
-void KdTreePhotonMap::build(std::vector<Photon> photons, float) {
+void KdTreePhotonMap::build_structure(std::vector<Photon> photons, float) {
     const size_t n = photons.size();
     if (n >= (size_t(1) << 31)) throw Error("kd-tree photon map", "too many photons: " + std::to_string(n));
     for (size_t i = 0; i < n; ++i)

@@ -11,8 +11,8 @@ namespace gilab {
 
 class KdTreePhotonMap final : public PhotonMap {
 public:
-    PhotonMapKind kind() const override { return PhotonMapKind::KdTree; }
-    void build(std::vector<Photon> photons, float radius = 0) override;
+    static constexpr PhotonMapKind kKind = PhotonMapKind::KdTree;
+    PhotonMapKind kind() const override { return kKind; }
     size_t size() const override { return nodes_.size(); }
     const Photon& photon(uint32_t index) const override { return nodes_[index]; }
     uint32_t original_index(uint32_t index) const override { return original_[index]; }
@@ -109,6 +109,9 @@ public:
         stats.visited += visited;
         stats.inside += inside;
     }
+
+protected:
+    void build_structure(std::vector<Photon> photons, float radius) override;
 
 private:
     std::vector<Photon> nodes_;       // node i + 1 at index i

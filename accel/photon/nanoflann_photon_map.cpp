@@ -90,7 +90,7 @@ struct NanoflannPhotonMap::Index {
 NanoflannPhotonMap::NanoflannPhotonMap(size_t leaf_max_size) : leaf_max_size_(std::max<size_t>(1, leaf_max_size)) {}
 NanoflannPhotonMap::~NanoflannPhotonMap() = default;
 
-void NanoflannPhotonMap::build(std::vector<Photon> photons, float) {
+void NanoflannPhotonMap::build_structure(std::vector<Photon> photons, float) {
     for (size_t i = 0; i < photons.size(); ++i)
         if (!is_finite(photons[i].position))
             throw Error("nanoflann photon map", "photon " + std::to_string(i) + " has a non-finite position");

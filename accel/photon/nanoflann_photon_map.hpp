@@ -13,8 +13,8 @@ class NanoflannPhotonMap final : public PhotonMap {
 public:
     explicit NanoflannPhotonMap(size_t leaf_max_size = 10);
     ~NanoflannPhotonMap() override;
-    PhotonMapKind kind() const override { return PhotonMapKind::Nanoflann; }
-    void build(std::vector<Photon> photons, float radius = 0) override;
+    static constexpr PhotonMapKind kKind = PhotonMapKind::Nanoflann;
+    PhotonMapKind kind() const override { return kKind; }
     size_t size() const override { return photons_.size(); }
     const Photon& photon(uint32_t index) const override { return photons_[index]; }
     uint32_t original_index(uint32_t index) const override { return index; }
@@ -25,6 +25,9 @@ public:
     // kNN with a filter applied before candidates compete (as the other structures' knn).
     void knn_filtered(const Vec3& x, size_t k, float max_r, NeighborHeap& heap, PhotonQueryStats& stats,
                       FunctionRef<bool(uint32_t)> accept) const;
+
+protected:
+    void build_structure(std::vector<Photon> photons, float radius) override;
 
 private:
     struct Index;

@@ -9,12 +9,17 @@
 // storage order (photon(i)); original_index(i) maps back to the build input.
 //
 // Each concrete structure also has inline template versions of both queries
-// (for_each_in_radius, knn) for hot loops; the virtual ones here wrap them.
+// (for_each_in_radius, knn) for hot loops; the virtual ones here wrap them. A hot loop
+// reaches them through as<Map>(), which names the concrete structure by its kind.
+//
+// The map owns its gather radius: build() records the radius the structure was built
+// for (the hash grid's cells are sized by it) and radius() gives it to the gather.
 #include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 #include "accel/photon/photon.hpp"
 
@@ -111,9 +116,30 @@ public:
     virtual PhotonMapKind kind() const = 0;
     std::string name() const { return to_string(kind()); }
 
-    // Replaces the content. `radius` is the gather radius the structure is tuned for
-    // (the hash grid's cell edge; ignored by the trees). Throws Error on bad input.
-    virtual void build(std::vector<Photon> photons, float radius) = 0;
+    // The concrete structure (HashGridPhotonMap, KdTreePhotonMap, NanoflannPhotonMap) if
+    // this map is one, else null. Each is final and the only map of its kind (Map::kKind).
+    template <typename Map>
+    const Map* as() const {
+        static_assert(std::is_base_of_v<PhotonMap, Map> && std::is_final_v<Map>, "a concrete photon map");
+        return kind() == Map::kKind ? static_cast<const Map*>(this) : nullptr;
+    }
+    template <typename Map>
+    Map* as() {
+        return const_cast<Map*>(std::as_const(*this).template as<Map>());
+    }
+
+    // Replaces the content, built for the gather radius `radius`, which radius() then
+    // returns. The hash grid's cell edge derives from it (it must be positive and finite);
+    // the trees do not depend on it, and 0 (the default) suits a tree queried only at
+    // radii of its own. Throws Error on bad input; radius() changes only with a build
+    // that succeeds.
+    void build(std::vector<Photon> photons, float radius = 0) {
+        build_structure(std::move(photons), radius);
+        radius_ = radius;
+    }
+    // The gather radius of the last build (0 before the first).
+    float radius() const { return radius_; }
+
     virtual size_t size() const = 0;
     bool empty() const { return size() == 0; }
     virtual const Photon& photon(uint32_t index) const = 0;
@@ -127,6 +153,13 @@ public:
     // within max_r of x.
     virtual void knn_query(const Vec3& x, size_t k, float max_r, NeighborHeap& heap,
                            PhotonQueryStats& stats) const = 0;
+
+protected:
+    // The structure's part of build().
+    virtual void build_structure(std::vector<Photon> photons, float radius) = 0;
+
+private:
+    float radius_ = 0;
 };
 
 std::unique_ptr<PhotonMap> make_photon_map(PhotonMapKind kind);

@@ -96,25 +96,20 @@ Vec3& part_of(PhotonEstimate& e, bool first_hit) { return first_hit ? e.direct :
 
 }  // namespace
 
-PhotonGatherer::PhotonGatherer(const PhotonMap& map, const std::vector<Material>& materials, GatherMode mode,
-                               float radius, size_t k)
-    : map_(map), materials_(materials), mode_(mode), radius_(radius), radius2_(radius * radius),
-      inv_area_(1.0f / (kPi * radius * radius)), k_(k) {
-    if (!(radius > 0.0f)) throw Error("photon gather", "radius must be positive");
-    grid_ = dynamic_cast<const HashGridPhotonMap*>(&map);
-    kd_ = dynamic_cast<const KdTreePhotonMap*>(&map);
-    nano_ = dynamic_cast<const NanoflannPhotonMap*>(&map);
-    if (grid_ && !grid_->empty() && grid_->radius() != radius)
-        throw Error("photon gather", "the hash grid was built for another radius; build it again");
-    // A query radius no larger than a cell meets at most the 3×3×3 cells around the
-    // point, which is what estimate() has room for.
-    if (grid_ && !grid_->empty() && !(grid_->cell_size() >= radius))
-        throw Error("photon gather", "the hash grid's cells (" + std::to_string(grid_->cell_size()) +
-                                         ") are smaller than the gather radius (" + std::to_string(radius) + ")");
+PhotonGatherer::PhotonGatherer(const PhotonMap& map, const std::vector<Material>& materials, GatherMode mode, size_t k)
+    : map_(map), materials_(materials), mode_(mode), radius_(map.radius()), radius2_(radius_ * radius_),
+      inv_area_(1.0f / (kPi * radius_ * radius_)), k_(k) {
+    if (!(radius_ > 0.0f))
+        throw Error("photon gather", "the photon map's radius must be positive (build the map with the gather radius)");
+    // The fast paths (null for the other kinds): the grid's runs, the kd-tree's inline
+    // queries, nanoflann's filtered kNN.
+    grid_ = map.as<HashGridPhotonMap>();
+    kd_ = map.as<KdTreePhotonMap>();
+    nano_ = map.as<NanoflannPhotonMap>();
     if (!grid_) {  // the trees' sort keys use r-sized cells from the photons' minimum
         Bounds3 box;
         for (uint32_t i = 0; i < map.size(); ++i) box.extend(map.photon(i).position);
-        key_origin_ = box.empty() ? Vec3(0) : box.min - radius;
+        key_origin_ = box.empty() ? Vec3(0) : box.min - radius_;
     }
 }
 
@@ -175,7 +170,7 @@ PhotonEstimate PhotonGatherer::estimate_parts(const GatherPoint& p, GatherScratc
     const bool glossy = m.has_glossy_lobe();
     if (grid_) {
         ++stats.queries;
-        constexpr size_t kMaxRuns = 27;  // 3×3×3 cells: the radius is at most a cell (checked at construction)
+        constexpr size_t kMaxRuns = 27;  // 3×3×3 cells: the grid's cell edge is at least its radius
         PhotonRun runs[kMaxRuns];
         size_t count = 0;
         grid_->for_each_run(p.position, radius_, [&](PhotonRun r) {

@@ -1,6 +1,9 @@
 #pragma once
 // Density estimation (P1 eq. 1): reflected radiance at a surface point from the photons
-// around it, L ≈ 1/(π r²) Σ f_r(x, ω_p, ω) ΔΦ_p, with the disk estimator over a fixed r.
+// around it, L ≈ 1/(π r²) Σ f_r(x, ω_p, ω) ΔΦ_p, with the disk estimator over a fixed r:
+// the photon map's radius (PhotonMap::radius(): the one the map was built for, which also
+// sizes the hash grid's cells). The map must outlive the gatherer and not be built again
+// while the gatherer is in use.
 // f_r is the view-independent diffuse part ρ/π for Lambertian materials (one multiply
 // after summing the flux) and the full BSDF (diffuse + glossy lobe) per photon for
 // glossy ones; photons arriving from below the surface (ω_p·n ≤ 0) contribute nothing.
@@ -55,7 +58,8 @@ struct GatherScratch {
 
 class PhotonGatherer {
 public:
-    PhotonGatherer(const PhotonMap& map, const std::vector<Material>& materials, GatherMode mode, float radius, size_t k);
+    // Throws Error if the map has no positive radius.
+    PhotonGatherer(const PhotonMap& map, const std::vector<Material>& materials, GatherMode mode, size_t k);
 
     // Σ f_r ΔΦ / (π r²) at p, by part, and in total.
     PhotonEstimate estimate_parts(const GatherPoint& p, GatherScratch& scratch, PhotonQueryStats& stats) const;

@@ -31,7 +31,7 @@ void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const E
 
     Stopwatch right_watch;
     const int width = right.width();
-    const PhotonGatherer gatherer(*map_, scene_.materials(), s.gather, s.radius, size_t(s.k));
+    const PhotonGatherer gatherer(*map_, scene_.materials(), s.gather, size_t(s.k));
     const PrimaryShadingContext shading{scene_.tracer(), scene_.frame(), scene_.materials(), scene_.lights(),
                                         s.light_samples};
     float* direct = film.layer("direct").data.data();

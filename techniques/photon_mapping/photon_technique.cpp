@@ -11,6 +11,19 @@
 
 namespace gilab {
 
+namespace {
+
+// A photon map of the configured kind and hash query, built over `photons` for the
+// gather radius.
+std::unique_ptr<PhotonMap> build_photon_map(const PhotonMappingSettings& s, std::vector<Photon> photons) {
+    auto map = make_photon_map(s.photon_map);
+    if (auto* grid = map->as<HashGridPhotonMap>()) grid->set_query_mode(s.hash_query);
+    map->build(std::move(photons), s.radius);
+    return map;
+}
+
+}  // namespace
+
 PhotonMappingTechnique::PhotonMappingTechnique() = default;
 PhotonMappingTechnique::~PhotonMappingTechnique() = default;
 
@@ -55,16 +68,10 @@ void PhotonMappingTechnique::trace_and_build() {
             p.power *= float(stride);
             kept.push_back(p);
         }
-        auto periphery = make_photon_map(settings_.photon_map);
-        if (auto* grid = dynamic_cast<HashGridPhotonMap*>(periphery.get())) grid->set_query_mode(settings_.hash_query);
-        periphery->build(std::move(kept), settings_.radius);
-        stats_.set("periphery_photons_stored", double(periphery->size()));
-        periphery_map_ = std::move(periphery);
+        periphery_map_ = build_photon_map(settings_, std::move(kept));
+        stats_.set("periphery_photons_stored", double(periphery_map_->size()));
     }
-    auto map = make_photon_map(settings_.photon_map);
-    if (auto* grid = dynamic_cast<HashGridPhotonMap*>(map.get())) grid->set_query_mode(settings_.hash_query);
-    map->build(std::move(traced.photons), settings_.radius);
-    map_ = std::move(map);
+    map_ = build_photon_map(settings_, std::move(traced.photons));
     stats_.set("photon_trace_ms", traced.trace_ms);
     stats_.set("photon_build_ms", build.elapsed_ms());
     stats_.set("photons_emitted", double(traced.emitted));
@@ -72,7 +79,7 @@ void PhotonMappingTechnique::trace_and_build() {
     stats_.set("photons_stored_first_hit", double(first_hits));
     stats_.set("photon_rays", double(traced.rays));
     stats_.set("photon_map_bytes", double(map_->memory_bytes()));
-    if (auto* grid = dynamic_cast<const HashGridPhotonMap*>(map_.get())) stats_.set("hash_cells", double(grid->cell_count()));
+    if (const auto* grid = map_->as<HashGridPhotonMap>()) stats_.set("hash_cells", double(grid->cell_count()));
 }
 
 void PhotonMappingTechnique::update(double time) {

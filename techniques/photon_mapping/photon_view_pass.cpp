@@ -39,9 +39,9 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
     const int width = camera.width(), height = camera.height();
     const PhotonMappingSettings& s = settings_;
     const int spp = s.sampling.spp;
-    const PhotonGatherer gatherer(*map_, scene_.materials(), s.gather, s.radius, size_t(s.k));
+    const PhotonGatherer gatherer(*map_, scene_.materials(), s.gather, size_t(s.k));
     std::optional<PhotonGatherer> periphery;
-    if (periphery_map_) periphery.emplace(*periphery_map_, scene_.materials(), s.gather, s.radius, size_t(s.k));
+    if (periphery_map_) periphery.emplace(*periphery_map_, scene_.materials(), s.gather, size_t(s.k));
     const PrimaryShadingContext shading{scene_.tracer(), scene_.frame(), scene_.materials(), scene_.lights(),
                                         s.light_samples};
     const size_t light_samples = shading.records_per_hit();

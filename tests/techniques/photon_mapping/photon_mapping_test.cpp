@@ -4,8 +4,8 @@
 // Cornell box matches the path tracer's; the white furnace gives the analytic indirect
 // light; every-hit storage adds a first-hit copy of every photon, splits direct from
 // indirect light and agrees with shadow rays; an empty photon map gives black indirect
-// without NaN; bad settings are errors naming the key; images do not depend on the
-// thread count.
+// without NaN; the gather radius is the photon map's; bad settings are errors naming the
+// key; images do not depend on the thread count.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -166,7 +166,7 @@ TEST(PhotonMapping, PaperTilesShareOnlyWhenEveryHitIsInOneCell) {
     const float r = 0.1f;
     const HashGridPhotonMap grid = uniform_grid(r);
     const std::vector<Material> materials(1);
-    const PhotonGatherer gatherer(grid, materials, GatherMode::Radius, r, 32);
+    const PhotonGatherer gatherer(grid, materials, GatherMode::Radius, 32);
     const glm::ivec3 cell = grid.cell_of(Vec3(0.5f));
     auto point_in = [&](const glm::ivec3& c, Rng& rng) {
         GatherPoint p;
@@ -257,6 +257,19 @@ TEST(PhotonMapping, PaperTilesShareOnlyWhenEveryHitIsInOneCell) {
         gather_tile_paper(gatherer, empty, out, scratch, qs, counts);
         EXPECT_EQ(counts.tiles_qualified + counts.tiles_mixed + counts.groups + qs.queries, 0u);
     }
+}
+
+// The gather radius is the photon map's: the one it was built for, which a map built
+// without one (a tree queried at radii of its own) does not have.
+TEST(PhotonMapping, GatherRadiusIsTheMaps) {
+    const std::vector<Material> materials(1);
+    const HashGridPhotonMap grid = uniform_grid(0.1f);
+    EXPECT_EQ(PhotonGatherer(grid, materials, GatherMode::Radius, 32).radius(), 0.1f);
+    KdTreePhotonMap tree;
+    tree.build({}, 0.05f);
+    EXPECT_EQ(PhotonGatherer(tree, materials, GatherMode::Knn, 32).radius(), 0.05f);
+    tree.build({});
+    EXPECT_THROW(PhotonGatherer(tree, materials, GatherMode::Radius, 32), Error);
 }
 
 TEST(PhotonMapping, TileSharedSettingReadsOldBooleans) {

@@ -115,7 +115,7 @@ ExpectedImage expected_image(const Scene& scene, const EyeCamera& camera, const 
     const SceneFrame frame = scene.evaluate(0);
     const RayTracer tracer(frame);
     const LightSampler lights(frame, scene.materials);
-    const PhotonGatherer gatherer(t.photon_map(), scene.materials, s.gather, s.radius, size_t(s.k));
+    const PhotonGatherer gatherer(t.photon_map(), scene.materials, s.gather, size_t(s.k));
     const PrimaryShadingContext shading{tracer, frame, scene.materials, lights, s.light_samples};
     ExpectedImage out;
     for (int y = 0; y < camera.height(); ++y)
