@@ -34,7 +34,13 @@ void report_unused_settings(const Technique& technique, const Settings& settings
     settings.report_unused("technique '" + technique.name() + "'");
 }
 
+void check_settings_known(const Technique& technique, const Settings& settings) {
+    if (const TechniqueInfo* info = TechniqueRegistry::builtin().find(technique.name()))
+        info->settings_schema().check_known(settings);
+}
+
 void prepare_technique(Technique& technique, const Scene& scene, const Settings& settings) {
+    check_settings_known(technique, settings);
     technique.prepare(scene, settings);
     report_unused_settings(technique, settings);
 }

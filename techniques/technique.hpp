@@ -71,6 +71,9 @@ private:
 // and, for unread keys, the technique.
 std::unique_ptr<Technique> prepare_technique(const std::string& name, const Scene& scene, const Settings& settings);
 void prepare_technique(Technique& technique, const Scene& scene, const Settings& settings);
+// Throws Error naming every key of `settings` that the technique's schema does not
+// declare, with the nearest declared key: before a prepare that may take minutes.
+void check_settings_known(const Technique& technique, const Settings& settings);
 // Throws Error naming every key of `settings` that `technique` did not read (misspelt,
 // or not one of its settings); for callers with checks of their own between the two.
 void report_unused_settings(const Technique& technique, const Settings& settings);

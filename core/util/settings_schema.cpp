@@ -204,7 +204,7 @@ void SettingsSchema::check_known(const Settings& settings) const {
             if (size_t d = edit_distance(unknown[i], s.key); d < best) best = d, nearest = &s;
         if (nearest) msg << " (did you mean '" << nearest->key << "'?)";
     }
-    msg << " for " << technique_ << "; `gilab list settings " << technique_ << "` lists them";
+    msg << " for technique '" << technique_ << "'; `gilab list settings " << technique_ << "` lists them";
     throw Error(settings.context(), msg.str());
 }
 

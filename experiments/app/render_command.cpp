@@ -275,15 +275,17 @@ ViewSet aim_views(TechniqueAndRig& setup, const RenderRequest& request, const Sc
 void prepare_render(TechniqueAndRig& setup, const RenderRequest& request, const Scene& scene) {
     Technique& technique = *setup.technique;
     const Settings& settings = setup.settings;
-    technique.prepare(scene, settings);
-    // --spp is stored as the setting 'spp'; a technique that never asks for it takes no
-    // pixel samples, which is the option's fault, not an unknown --set key.
-    if (request.spp && !settings.was_read("spp"))
+    // --spp is stored as the setting 'spp'; a technique that declares no such setting
+    // takes no pixel samples, which is the option's fault, not an unknown --set key.
+    const SettingsSchema& schema = TechniqueRegistry::builtin().find(technique.name())->settings_schema();
+    if (request.spp && !schema.declares("spp"))
         throw Error("--spp", "technique '" + technique.name() +
-                                 "' takes no pixel samples (it reads no setting 'spp'); leave --spp out");
-    if (request.time_budget && !settings.was_read("time_budget"))
+                                 "' takes no pixel samples (it has no setting 'spp'); leave --spp out");
+    if (request.time_budget && !schema.declares("time_budget"))
         throw Error("--time-budget", "technique '" + technique.name() +
-                                         "' takes no time budget (it reads no setting 'time_budget'); leave --time-budget out");
+                                         "' takes no time budget (it has no setting 'time_budget'); leave --time-budget out");
+    check_settings_known(technique, settings);
+    technique.prepare(scene, settings);
     report_unused_settings(technique, settings);
 }
 
