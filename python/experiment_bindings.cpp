@@ -1,4 +1,4 @@
-// gilab.experiments() and gilab.run_experiment(): the experiment registry and runner of
+// gilab.experiments(), gilab.experiment_plan() and gilab.run_experiment(): the experiment registry and runner of
 // `gilab experiment`, with the result tables handed back as lists of dicts.
 #include <cstdlib>
 #include <filesystem>
@@ -83,6 +83,20 @@ void register_experiment_bindings(py::module_& m) {
             return list;
         },
         "The registered experiments as dicts (name, paper, description), as `gilab experiment list`.");
+
+    m.def(
+        "experiment_plan",
+        [](const std::string& name, bool quick) {
+            const Experiment& experiment = ExperimentRegistry::builtin().get(name);
+            if (!experiment.spec)
+                throw Error(name, "this experiment is not declared as a spec, so it has no task plan");
+            py::list tasks;
+            for (const SpecTask& t : plan_tasks(*experiment.spec, quick)) tasks.append(json_to_python(t.to_json()));
+            return tasks;
+        },
+        "name"_a, "quick"_a = true,
+        "The tasks of a declared experiment as dicts (id, scene, variant, technique, axes, settings), as `gilab "
+        "experiment plan NAME`.");
 
     m.def(
         "run_experiment",

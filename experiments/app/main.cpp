@@ -10,6 +10,7 @@
 #include "experiments/report/compare_report.hpp"
 #include "experiments/runner/experiment.hpp"
 #include "experiments/runner/experiment_batch.hpp"
+#include "experiments/runner/task_command.hpp"
 #include "experiments/report/html_report.hpp"
 #include "experiments/app/render_command.hpp"
 #include "scenes/builtin_scenes.hpp"
@@ -147,8 +148,12 @@ int main(int argc, char** argv) {
     std::vector<std::string> experiment_names;
     bool quick = false;
     std::string results_dir = "results";
-    auto* experiment = app.add_subcommand("experiment", "run experiments: `list`, a name, several names, or `all`");
-    experiment->add_option("names", experiment_names, "experiment names, `all`, or `list`")->required();
+    auto* experiment = app.add_subcommand(
+        "experiment", "run experiments: `list`, a name, several names, or `all`; for a declared experiment also "
+                      "`plan NAME` (its tasks as JSON lines), `run-task NAME ID` (one task, written to "
+                      "RESULTS/NAME/tasks/ID.json) and `merge NAME` (the tables from the tasks that exist)");
+    experiment->add_option("names", experiment_names, "experiment names, `all`, `list`, or plan|run-task|merge NAME [ID]")
+        ->required();
     experiment->add_flag("--quick", quick, "small sizes (smoke run, minutes)");
     experiment->add_option("--results", results_dir, "results root directory")->capture_default_str();
     experiment->add_option("--seed", seed, "random seed")->capture_default_str();
@@ -244,6 +249,18 @@ int main(int argc, char** argv) {
             if (experiment_names.size() == 1 && experiment_names[0] == "list") {
                 print_list("experiments");
                 return 0;
+            }
+            const std::string& verb = experiment_names[0];
+            if (verb == "plan" || verb == "run-task" || verb == "merge") {
+                TaskCommand command;
+                command.verb = verb;
+                command.arguments.assign(experiment_names.begin() + 1, experiment_names.end());
+                command.results_root = results_dir;
+                command.quick = quick;
+                command.seed = seed;
+                command.threads = threads;
+                command.assets = assets;
+                return run_task_command(command, std::cout);
             }
             ExperimentBatch batch;
             const ExperimentRegistry& registry = ExperimentRegistry::builtin();

@@ -500,6 +500,7 @@ ExperimentOutput run_fig8(const ExperimentContext& ctx) {
 }  // namespace
 
 Experiment photon_convergence_experiment();  // pm-convergence, photon_convergence_experiment.cpp
+Experiment radius_sweep_experiment();        // pm-radius-sweep, radius_sweep_experiment.cpp
 
 void register_photon_experiments(ExperimentRegistry& registry) {
     registry.add({"pm-table1", "P1",
@@ -515,6 +516,7 @@ void register_photon_experiments(ExperimentRegistry& registry) {
     registry.add({"pm-fig8", "P1", "Fig. 8: images with a heap of 128 vs without heap, 512² photons, r = 0.08",
                   run_fig8});
     registry.add(photon_convergence_experiment());
+    registry.add(radius_sweep_experiment());
 }
 
 }  // namespace gilab

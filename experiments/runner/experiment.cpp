@@ -10,6 +10,7 @@
 #include "core/util/stats.hpp"
 #include "experiments/runner/plot.hpp"
 #include "experiments/runner/result_writers.hpp"
+#include "experiments/runner/spec_runner.hpp"
 
 namespace gilab {
 
@@ -45,6 +46,18 @@ const Experiment& ExperimentRegistry::get(const std::string& name) const {
     std::string known;
     for (const auto& e : experiments_) known += (known.empty() ? "" : ", ") + e.name;
     throw Error(name, "unknown experiment (known: " + known + ")");
+}
+
+Experiment declared_experiment(ExperimentSpec spec) {
+    spec.check();
+    auto shared = std::make_shared<const ExperimentSpec>(std::move(spec));
+    Experiment e;
+    e.name = shared->name;
+    e.paper = shared->paper;
+    e.description = shared->figure + ": " + shared->description;
+    e.spec = shared;
+    e.run = [shared](const ExperimentContext& ctx) { return run_spec(*shared, ctx); };
+    return e;
 }
 
 ExperimentOutput run_and_write(const Experiment& experiment, ExperimentContext context) {

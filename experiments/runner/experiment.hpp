@@ -4,12 +4,14 @@
 // and the runner writes them to results/NAME/ atomically.
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <ostream>
 #include <string>
 #include <utility>
 #include <vector>
 #include <nlohmann/json.hpp>
 #include "core/io/asset_paths.hpp"
+#include "experiments/runner/experiment_spec.hpp"
 #include "experiments/runner/plot.hpp"
 
 namespace gilab {
@@ -43,11 +45,25 @@ struct ExperimentOutput {
 };
 
 struct Experiment {
+    Experiment() = default;
+    Experiment(std::string name, std::string paper, std::string description,
+               std::function<ExperimentOutput(const ExperimentContext&)> run,
+               std::shared_ptr<const ExperimentSpec> spec = nullptr)
+        : name(std::move(name)), paper(std::move(paper)), description(std::move(description)), run(std::move(run)),
+          spec(std::move(spec)) {}
+
     std::string name;          // e.g. "core-rays", "pm-table1"
     std::string paper;         // "P1", "P2", "P3" or "core"
     std::string description;
     std::function<ExperimentOutput(const ExperimentContext&)> run;
+    // Set for an experiment declared as data: `gilab experiment plan | run-task | merge`
+    // work on it, and `run` is the generic runner's (declared_experiment).
+    std::shared_ptr<const ExperimentSpec> spec;
 };
+
+// An Experiment run by the generic runner from its spec (spec_runner.hpp); the spec is
+// checked here, so a bad one fails at registration.
+Experiment declared_experiment(ExperimentSpec spec);
 
 class ExperimentRegistry {
 public:

@@ -83,6 +83,7 @@ void DagRaycastTechnique::prepare(const Scene& scene, const Settings& settings) 
     Stopwatch watch;
     animation_ = AnimationDag();
     settings_ = DagRaycastSettings::from(settings);
+    config_hash_ = settings.hash();
     const std::string where = scene.source.empty() ? scene.name : scene.source;
     fps_ = settings_.fps > 0 ? settings_.fps : scene.frames_per_second;
     if (!(fps_ > 0) || !std::isfinite(fps_))
@@ -223,7 +224,7 @@ void DagRaycastTechnique::render(const ViewSet& views, std::vector<Film>& films)
             rays += tile_rays;
             primary_visits += tile_visits;
         });
-        write_film_provenance(film, kName, views, v, settings_.seed);
+        write_film_provenance(film, kName, views, v, settings_.seed, config_hash_);
         film.metadata["frame"] = std::to_string(frame);
         film.metadata["frame_time"] = format_number(animation_.times[frame]);
         film.metadata["build"] = to_string(settings_.build);

@@ -47,6 +47,7 @@ private:
     void prepare_shadows(const Scene& scene);
 
     DagRaycastSettings settings_;
+    std::string config_hash_;  // of the settings as given (film provenance)
     AnimationDag animation_;
     double fps_ = 30.0;
     int light_index_ = -1;  // into each frame's lights; -1 = headlight

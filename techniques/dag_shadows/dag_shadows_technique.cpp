@@ -96,6 +96,7 @@ DagShadowsSettings DagShadowsSettings::from(const Settings& s) {
 void DagShadowsTechnique::prepare(const Scene& scene, const Settings& settings) {
     Stopwatch watch;
     settings_ = DagShadowsSettings::from(settings);
+    config_hash_ = settings.hash();
     scene_.load(scene);
     source_ = &scene;
     const auto& lights = scene_.frame().lights;
@@ -252,7 +253,7 @@ void DagShadowsTechnique::render(const ViewSet& views, std::vector<Film>& films)
                 film.set("visibility", x, y, vis[k]);
             }
         });
-        write_film_provenance(film, kName, views, v, settings_.seed);
+        write_film_provenance(film, kName, views, v, settings_.seed, config_hash_);
         film.metadata["visibility"] = to_string(settings_.visibility);
         film.metadata["resolution"] = std::to_string(settings_.resolution);
         films[v] = std::move(film);

@@ -53,6 +53,7 @@ private:
     const PunctualLight& light() const { return scene_.frame().lights[light_index_]; }
 
     DagShadowsSettings settings_;
+    std::string config_hash_;  // of the settings as given (film provenance)
     const Scene* source_ = nullptr;
     TracedScene scene_;
     int light_index_ = 0;

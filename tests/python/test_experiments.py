@@ -38,3 +38,14 @@ def test_run_without_results_leaves_nothing(tmp_path, monkeypatch):
 def test_unknown_experiment_lists_the_names():
     with pytest.raises(gilab.Error, match="pm-table1"):
         gilab.run_experiment("pm-table99")
+
+
+def test_experiment_plan_matches_the_cli(run_cli):
+    """gilab.experiment_plan gives the tasks `gilab experiment plan` prints."""
+    plan = gilab.experiment_plan("pm-radius-sweep", quick=True)
+    printed = [json.loads(line) for line in run_cli("experiment", "plan", "pm-radius-sweep", "--quick").stdout.splitlines()]
+    assert plan == printed
+    assert [t["id"] for t in plan] == list(range(len(plan)))
+    assert {t["technique"] for t in plan} == {"photon"}
+    with pytest.raises(gilab.Error, match="not declared as a spec"):
+        gilab.experiment_plan("pm-table1")

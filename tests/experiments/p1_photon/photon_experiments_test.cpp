@@ -260,7 +260,9 @@ TEST(PhotonConvergence, TheReferenceIsAtMostATenthOfTheSmallestErrorReported) {
         const std::string scene = row.at("scene");
         const double n = row.at("reference noise (relMSE)").get<double>();
         EXPECT_GT(n, 0.0) << row.dump();
-        if (noise.count(scene)) EXPECT_EQ(noise[scene], n) << "one reference per scene: " << row.dump();
+        if (noise.count(scene)) {
+            EXPECT_EQ(noise[scene], n) << "one reference per scene: " << row.dump();
+        }
         noise[scene] = n;
         if (row.at("relMSE").is_number())
             smallest[scene] = std::min(smallest.count(scene) ? smallest[scene] : 1e300, row.at("relMSE").get<double>());

@@ -1,0 +1,179 @@
+#include "experiments/runner/spec_runner.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <optional>
+#include <set>
+#include "core/image/image_io.hpp"
+#include "core/image/image_metrics.hpp"
+#include "core/util/error.hpp"
+#include "core/util/stats.hpp"
+#include "experiments/runner/path_reference.hpp"
+#include "experiments/runner/result_writers.hpp"
+#include "scenes/scene_library.hpp"
+#include "techniques/technique.hpp"
+
+namespace gilab {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+int size_of(const ExperimentSpec& s, bool quick) { return quick ? s.quick_size : s.size; }
+int frames_of(const ExperimentSpec& s, bool quick) { return quick ? s.quick_frames : s.frames; }
+int reference_spp_of(const ExperimentSpec& s, bool quick) { return quick ? s.quick_reference_spp : s.reference_spp; }
+
+EyeCamera spec_camera(const Scene& scene, int size) {
+    const SceneCamera& c = *scene.camera;
+    return EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, size, size);
+}
+
+// What identifies a task's work: a result file must match it to be merged.
+nlohmann::json task_identity(const SpecTask& t, bool quick, uint64_t seed) {
+    return {{"task", t.to_json()}, {"quick", quick}, {"seed", seed}};
+}
+
+}  // namespace
+
+fs::path spec_task_file(const fs::path& output_dir, int task_id) {
+    return output_dir / "tasks" / (std::to_string(task_id) + ".json");
+}
+
+nlohmann::json run_spec_task(const ExperimentSpec& spec, int task_id, const ExperimentContext& ctx) {
+    const std::vector<SpecTask> tasks = plan_tasks(spec, ctx.quick);
+    if (task_id < 0 || task_id >= int(tasks.size()))
+        throw Error(spec.name, "no task " + std::to_string(task_id) + " in the " + (ctx.quick ? "quick " : "") +
+                                   "plan (tasks 0 to " + std::to_string(tasks.size() - 1) +
+                                   "; `gilab experiment plan " + spec.name + "` lists them)");
+    const SpecTask& task = tasks[size_t(task_id)];
+    fs::create_directories(ctx.output_dir);  // the reference cache and tasks/ live there
+    const int size = size_of(spec, ctx.quick), frames = frames_of(spec, ctx.quick);
+
+    Scene scene = open_scene(task.scene, ctx.assets).scene;
+    const EyeCamera camera = spec_camera(scene, size);
+    nlohmann::json settings = task.settings;
+    if (!settings.contains("seed")) settings["seed"] = ctx.seed;
+    Settings given(settings, spec.name + " task " + std::to_string(task.id) + " (" + task.variant + ")");
+    ctx.say("task " + std::to_string(task.id) + ": " + task.scene + ", " + task.variant + ", " + task.axes.dump());
+    std::unique_ptr<Technique> technique = prepare_technique(task.technique, scene, given);
+    const Stats prepared = technique->stats();
+
+    std::map<std::string, std::vector<double>> per_frame;
+    std::vector<Film> films;
+    for (int f = 0; f < frames; ++f) {
+        technique->render(ViewSet::mono(camera), films);
+        const Stats stats = technique->stats();
+        for (const SpecMeasure& m : spec.measures)
+            if (m.source == SpecMeasure::Source::FrameStat) per_frame[m.key].push_back(stats.get(m.key));
+    }
+    std::optional<Film> reference;  // rendered (or read from the cache) once per task
+    nlohmann::json measures = nlohmann::json::object();
+    for (const SpecMeasure& m : spec.measures) {
+        switch (m.source) {
+            case SpecMeasure::Source::FrameStat: measures[m.column] = median(per_frame[m.key]); break;
+            case SpecMeasure::Source::PrepareStat: measures[m.column] = prepared.get(m.key); break;
+            case SpecMeasure::Source::RelMse: {
+                std::vector<std::string> files;
+                if (!reference) reference = path_reference(ctx, scene, camera, reference_spp_of(spec, ctx.quick), files);
+                measures[m.column] = relative_mse(films.at(0), *reference, m.key);
+                break;
+            }
+        }
+    }
+    nlohmann::json result = task_identity(task, ctx.quick, ctx.seed);
+    result["frames"] = frames;
+    result["size"] = size;
+    result["measures"] = measures;
+    result["per_frame"] = per_frame;
+    result["git_revision"] = git_revision();
+    result["threads"] = ctx.threads > 0 ? ctx.threads : int(machine_description()["tbb_threads"]);
+    const fs::path file = spec_task_file(ctx.output_dir, task.id);
+    fs::create_directories(file.parent_path());
+    write_file_atomically(file, result.dump(2) + "\n");
+    return result;
+}
+
+ExperimentOutput merge_spec_tasks(const ExperimentSpec& spec, const ExperimentContext& ctx) {
+    const std::vector<SpecTask> tasks = plan_tasks(spec, ctx.quick);
+    ExperimentOutput out;
+    ResultTable table;
+    table.title = spec.figure + " — " + spec.description;
+    table.columns = {"scene"};
+    for (const SpecAxis& a : spec.axes) table.columns.push_back(a.setting);
+    table.columns.push_back("variant");
+    for (const SpecMeasure& m : spec.measures) table.columns.push_back(m.column);
+    table.columns.push_back("frames");
+
+    std::vector<int> missing;
+    std::set<std::string> revisions, threads;
+    for (const SpecTask& task : tasks) {
+        const fs::path file = spec_task_file(ctx.output_dir, task.id);
+        if (!fs::exists(file)) {
+            missing.push_back(task.id);
+            continue;
+        }
+        std::ifstream in(file);
+        nlohmann::json result;
+        try {
+            result = nlohmann::json::parse(in);
+        } catch (const nlohmann::json::exception& e) {
+            throw Error(file.string(), std::string("not a task result: ") + e.what());
+        }
+        const nlohmann::json identity = task_identity(task, ctx.quick, ctx.seed);
+        for (const char* key : {"task", "quick", "seed"})
+            if (!result.contains(key) || result[key] != identity[key])
+                throw Error(file.string(), std::string("written for another plan (its '") + key +
+                                               "' differs from task " + std::to_string(task.id) + " of the " +
+                                               (ctx.quick ? "quick " : "") + "plan with seed " +
+                                               std::to_string(ctx.seed) + "); remove it or run the task again");
+        nlohmann::json row;
+        row["scene"] = task.scene;
+        for (auto it = task.axes.begin(); it != task.axes.end(); ++it) row[it.key()] = it.value();
+        row["variant"] = task.variant;
+        for (const SpecMeasure& m : spec.measures) row[m.column] = result.at("measures").at(m.column);
+        row["frames"] = result.at("frames");
+        table.rows.push_back(std::move(row));
+        revisions.insert(result.value("git_revision", std::string("unknown")));
+        threads.insert(std::to_string(result.value("threads", 0)));
+    }
+    if (table.rows.empty())
+        throw Error(spec.name, "no task has run yet (" + (ctx.output_dir / "tasks").string() + " holds none of the " +
+                                   std::to_string(tasks.size()) + " tasks)");
+    out.tables.push_back(std::move(table));
+    out.config = spec.to_json();
+    out.config["effective"] = {{"quick", ctx.quick},
+                               {"size", size_of(spec, ctx.quick)},
+                               {"frames", frames_of(spec, ctx.quick)},
+                               {"tasks", tasks.size()}};
+    if (spec.needs_reference()) out.config["effective"]["reference_spp"] = reference_spp_of(spec, ctx.quick);
+    out.notes = spec.notes;
+    if (!missing.empty()) {
+        std::string list;
+        for (int id : missing) list += (list.empty() ? "" : ", ") + std::to_string(id);
+        out.notes.push_back("Incomplete: " + std::to_string(missing.size()) + " of " + std::to_string(tasks.size()) +
+                            " tasks have not run (" + list + ").");
+    }
+    if (revisions.size() > 1 || threads.size() > 1) {
+        std::string r, t;
+        for (const auto& s : revisions) r += (r.empty() ? "" : ", ") + s;
+        for (const auto& s : threads) t += (t.empty() ? "" : ", ") + s;
+        out.notes.push_back("Tasks ran at more than one revision or thread count (revisions " + r + "; threads " + t +
+                            "): times are comparable only within one.");
+    }
+    return out;
+}
+
+ExperimentOutput run_spec(const ExperimentSpec& spec, const ExperimentContext& ctx) {
+    const std::vector<SpecTask> tasks = plan_tasks(spec, ctx.quick);
+    // A fresh run: task files of an earlier run would be merged as if from this one.
+    fs::remove_all(ctx.output_dir / "tasks");
+    for (const SpecTask& task : tasks) run_spec_task(spec, task.id, ctx);
+    return merge_spec_tasks(spec, ctx);
+}
+
+}  // namespace gilab

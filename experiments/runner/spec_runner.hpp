@@ -1,0 +1,30 @@
+#pragma once
+// The generic runner of declared experiments (experiment_spec.hpp): a task is prepared
+// through prepare_technique, rendered `frames` times and measured; its raw result goes
+// atomically to results/NAME/tasks/ID.json on its own, so tasks can run anywhere (one
+// by one, on several machines, as a job array) and be merged afterwards. Running the
+// whole experiment is plan, every task, then merge.
+#include <filesystem>
+#include <string>
+#include <nlohmann/json.hpp>
+#include "experiments/runner/experiment.hpp"
+#include "experiments/runner/experiment_spec.hpp"
+
+namespace gilab {
+
+// results/NAME/tasks/ID.json under the experiment's output directory.
+std::filesystem::path spec_task_file(const std::filesystem::path& output_dir, int task_id);
+
+// Runs task `task_id` of the plan (ctx.quick chooses the plan) and writes its result
+// file; returns the result. Throws Error naming the task for an id outside the plan.
+nlohmann::json run_spec_task(const ExperimentSpec& spec, int task_id, const ExperimentContext& ctx);
+
+// Reduces the task files in ctx.output_dir/tasks into the experiment's tables. Refuses
+// a task file written for another plan (another --quick, spec or task order) naming the
+// file; tasks not run yet are listed in a note, and no task at all is an Error.
+ExperimentOutput merge_spec_tasks(const ExperimentSpec& spec, const ExperimentContext& ctx);
+
+// Plan, run every task, merge: what `gilab experiment NAME` does for a declared one.
+ExperimentOutput run_spec(const ExperimentSpec& spec, const ExperimentContext& ctx);
+
+}  // namespace gilab

@@ -1,0 +1,64 @@
+#include "experiments/runner/task_command.hpp"
+
+#include <charconv>
+#include "core/util/error.hpp"
+#include "experiments/runner/experiment.hpp"
+#include "experiments/runner/spec_runner.hpp"
+
+namespace gilab {
+
+namespace {
+
+const Experiment& declared(const std::string& name) {
+    const Experiment& e = ExperimentRegistry::builtin().get(name);  // throws listing the known ones
+    if (!e.spec) {
+        std::string declared_ones;
+        for (const Experiment& other : ExperimentRegistry::builtin().list())
+            if (other.spec) declared_ones += (declared_ones.empty() ? "" : ", ") + other.name;
+        throw Error(name, "this experiment is not declared as a spec, so it runs only whole (`gilab experiment " + name +
+                              "`); declared ones: " + (declared_ones.empty() ? "none" : declared_ones));
+    }
+    return e;
+}
+
+int task_id(const std::string& text) {
+    int id = -1;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), id);
+    if (ec != std::errc() || end != text.data() + text.size() || id < 0)
+        throw Error("run-task", "'" + text + "' is not a task id (a number from `gilab experiment plan`)");
+    return id;
+}
+
+}  // namespace
+
+int run_task_command(const TaskCommand& c, std::ostream& out) {
+    const size_t wanted = c.verb == "run-task" ? 2 : 1;
+    if (c.arguments.size() != wanted)
+        throw Error(c.verb, c.verb == "run-task" ? "needs an experiment name and a task id: run-task NAME ID"
+                                                 : "needs one experiment name: " + c.verb + " NAME");
+    const Experiment& e = declared(c.arguments[0]);
+    if (c.verb == "plan") {
+        for (const SpecTask& t : plan_tasks(*e.spec, c.quick)) out << t.to_json().dump() << "\n";
+        return 0;
+    }
+    ExperimentContext ctx;
+    ctx.quick = c.quick;
+    ctx.output_dir = c.results_root / e.name;
+    ctx.assets = c.assets;
+    ctx.seed = c.seed;
+    ctx.threads = c.threads;
+    ctx.log = &out;
+    if (c.verb == "run-task") {
+        const int id = task_id(c.arguments[1]);
+        run_spec_task(*e.spec, id, ctx);
+        out << "wrote " << spec_task_file(ctx.output_dir, id).string() << "\n";
+        return 0;
+    }
+    Experiment merging = e;
+    merging.run = [&e](const ExperimentContext& context) { return merge_spec_tasks(*e.spec, context); };
+    run_and_write(merging, ctx);
+    out << "wrote " << (ctx.output_dir / "table.md").string() << "\n";
+    return 0;
+}
+
+}  // namespace gilab

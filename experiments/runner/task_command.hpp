@@ -1,0 +1,30 @@
+#pragma once
+// `gilab experiment plan NAME`, `run-task NAME ID` and `merge NAME`: a declared
+// experiment taken apart, so its tasks can run one by one, on other machines or as a job
+// array, and be reduced afterwards into the same tables as the one-command run.
+#include <filesystem>
+#include <ostream>
+#include <string>
+#include <vector>
+#include "core/io/asset_paths.hpp"
+
+namespace gilab {
+
+struct TaskCommand {
+    std::string verb;                     // plan | run-task | merge
+    std::vector<std::string> arguments;   // NAME [ID]
+    std::filesystem::path results_root = "results";
+    bool quick = false;
+    uint64_t seed = 1;
+    int threads = 0;
+    AssetPaths assets;
+};
+
+// plan: one JSON line per task (id, scene, variant, technique, axes, settings).
+// run-task: runs task ID and writes RESULTS/NAME/tasks/ID.json.
+// merge: writes RESULTS/NAME/results.csv, results.json and table.md from the tasks there.
+// Returns the exit code; errors (an experiment that is not declared as a spec, a bad id)
+// are thrown as Error.
+int run_task_command(const TaskCommand& command, std::ostream& out);
+
+}  // namespace gilab

@@ -1,0 +1,147 @@
+// Declared experiments: the plan, one task at a time, and merging tasks that ran
+// separately into the same tables as the one-command run.
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <gtest/gtest.h>
+#include "core/util/error.hpp"
+#include "experiments/runner/experiment.hpp"
+#include "experiments/runner/spec_runner.hpp"
+#include "experiments/runner/task_command.hpp"
+#include "tests/test_support.hpp"
+
+namespace gilab {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+// A small spec on the built-in Cornell box: two variants × two photon counts × one radius.
+ExperimentSpec cornell_spec() {
+    using Source = SpecMeasure::Source;
+    return {
+        .name = "test-sweep",
+        .paper = "P1",
+        .figure = "Test",
+        .description = "two photon maps, two photon counts",
+        .scenes = {"cornell"},
+        .size = 24, .quick_size = 16,
+        .frames = 2, .quick_frames = 2,
+        .reference_spp = 8, .quick_reference_spp = 4,
+        .variants = {{"hash grid", "photon", {{"photon_map", "hash_grid"}}},
+                     {"kd-tree", "photon", {{"photon_map", "kd_tree"}}}},
+        .axes = {{"photons", {4096, 8192}, {1024, 2048}}, {"radius", {0.1}, {0.1}}},
+        .measures = {{"frame_ms", Source::FrameStat, "render_ms"},
+                     {"photons_stored", Source::PrepareStat, "photons_stored"},
+                     {"relmse_color", Source::RelMse, "color"}},
+        .notes = {"a spec for the tests"},
+    };
+}
+
+ExperimentContext context(const fs::path& dir, bool quick = true) {
+    ExperimentContext ctx;
+    ctx.quick = quick;
+    ctx.output_dir = dir;
+    ctx.seed = 3;
+    return ctx;
+}
+
+TEST(SpecRunner, ThePlanIsEveryCombinationWithTheAxesApplied) {
+    const std::vector<SpecTask> quick = plan_tasks(cornell_spec(), true);
+    ASSERT_EQ(quick.size(), 4u);  // 2 photon counts × 1 radius × 2 variants
+    EXPECT_EQ(quick[0].settings, (json{{"photon_map", "hash_grid"}, {"photons", 1024}, {"radius", 0.1}}));
+    EXPECT_EQ(quick[1].variant, "kd-tree");
+    EXPECT_EQ(quick[3].axes, (json{{"photons", 2048}, {"radius", 0.1}}));
+    for (size_t i = 0; i < quick.size(); ++i) EXPECT_EQ(quick[i].id, int(i));
+    EXPECT_EQ(plan_tasks(cornell_spec(), false)[2].axes.at("photons"), 8192);
+}
+
+TEST(SpecRunner, ABadSpecIsRefusedNamingTheProblem) {
+    ExperimentSpec unknown_key = cornell_spec();
+    unknown_key.variants[0].settings["photon_maps"] = "kd_tree";
+    EXPECT_NE(test::error_of([&] { unknown_key.check(); }).find("'photon_maps' (did you mean 'photon_map'?)"),
+              std::string::npos);
+    ExperimentSpec unknown_axis = cornell_spec();
+    unknown_axis.axes.push_back({"cones", {1}, {1}});
+    EXPECT_NE(test::error_of([&] { unknown_axis.check(); }).find("axis 'cones'"), std::string::npos);
+    ExperimentSpec unknown_technique = cornell_spec();
+    unknown_technique.variants[0].technique = "photons";
+    EXPECT_NE(test::error_of([&] { unknown_technique.check(); }).find("unknown technique"), std::string::npos);
+    ExperimentSpec empty_axis = cornell_spec();
+    empty_axis.axes[0].quick.clear();
+    EXPECT_NE(test::error_of([&] { empty_axis.check(); }).find("no values"), std::string::npos);
+}
+
+TEST(SpecRunner, TasksRunSeparatelyMergeIntoTheTablesOfTheWholeRun) {
+    const ExperimentSpec spec = cornell_spec();
+    const fs::path whole_dir = test::temp_dir("spec_whole"), parts_dir = test::temp_dir("spec_parts");
+    const ExperimentOutput whole = run_spec(spec, context(whole_dir));
+    // The tasks in reverse order, as separate machines might finish them.
+    for (int id = 3; id >= 0; --id) run_spec_task(spec, id, context(parts_dir));
+    const ExperimentOutput merged = merge_spec_tasks(spec, context(parts_dir));
+    ASSERT_EQ(whole.tables.size(), 1u);
+    ASSERT_EQ(merged.tables.size(), 1u);
+    const ResultTable &a = whole.tables[0], &b = merged.tables[0];
+    EXPECT_EQ(a.columns, b.columns);
+    EXPECT_EQ(a.columns, (std::vector<std::string>{"scene", "photons", "radius", "variant", "frame_ms",
+                                                   "photons_stored", "relmse_color", "frames"}));
+    ASSERT_EQ(a.rows.size(), 4u);
+    ASSERT_EQ(b.rows.size(), 4u);
+    for (size_t i = 0; i < a.rows.size(); ++i) {
+        for (const char* key : {"scene", "photons", "radius", "variant", "photons_stored", "relmse_color", "frames"})
+            EXPECT_EQ(a.rows[i].at(key), b.rows[i].at(key)) << key << " in row " << i;
+        EXPECT_GT(a.rows[i].at("frame_ms").get<double>(), 0.0);
+        EXPECT_GT(b.rows[i].at("frame_ms").get<double>(), 0.0);
+        EXPECT_GT(a.rows[i].at("relmse_color").get<double>(), 0.0);
+    }
+    // More photons are stored when more are emitted, and the two maps store the same photons.
+    EXPECT_LT(a.rows[0].at("photons_stored").get<double>(), a.rows[2].at("photons_stored").get<double>());
+    EXPECT_EQ(a.rows[0].at("photons_stored"), a.rows[1].at("photons_stored"));
+    EXPECT_EQ(whole.config.at("name"), "test-sweep");
+    EXPECT_EQ(whole.config.at("effective").at("tasks"), 4);
+}
+
+TEST(SpecRunner, MergeListsMissingTasksAndRefusesAnotherPlansFiles) {
+    const ExperimentSpec spec = cornell_spec();
+    const fs::path dir = test::temp_dir("spec_merge");
+    EXPECT_NE(test::error_of([&] { merge_spec_tasks(spec, context(dir)); }).find("no task has run yet"),
+              std::string::npos);
+    run_spec_task(spec, 2, context(dir));
+    const ExperimentOutput partial = merge_spec_tasks(spec, context(dir));
+    ASSERT_EQ(partial.tables.at(0).rows.size(), 1u);
+    bool listed = false;
+    for (const std::string& note : partial.notes) listed |= note.find("3 of 4 tasks have not run (0, 1, 3)") != std::string::npos;
+    EXPECT_TRUE(listed);
+    // The quick plan's task 2 is not the full plan's task 2.
+    const std::string error = test::error_of([&] { merge_spec_tasks(spec, context(dir, false)); });
+    EXPECT_NE(error.find("2.json"), std::string::npos) << error;
+    EXPECT_NE(error.find("written for another plan"), std::string::npos) << error;
+    EXPECT_NE(test::error_of([&] { run_spec_task(spec, 4, context(dir)); }).find("no task 4"), std::string::npos);
+}
+
+TEST(SpecRunner, TheCommandPlansDeclaredExperimentsOnly) {
+    TaskCommand plan;
+    plan.verb = "plan";
+    plan.arguments = {"pm-radius-sweep"};
+    plan.quick = true;
+    std::ostringstream out;
+    EXPECT_EQ(run_task_command(plan, out), 0);
+    std::istringstream lines(out.str());
+    int count = 0;
+    for (std::string line; std::getline(lines, line); ++count) {
+        const json task = json::parse(line);
+        EXPECT_EQ(task.at("id"), count);
+        EXPECT_EQ(task.at("technique"), "photon");
+        EXPECT_TRUE(task.at("settings").contains("radius"));
+    }
+    EXPECT_EQ(count, 4);
+    plan.arguments = {"pm-table1"};
+    EXPECT_NE(test::error_of([&] { run_task_command(plan, out); }).find("not declared as a spec"), std::string::npos);
+    TaskCommand bad_id;
+    bad_id.verb = "run-task";
+    bad_id.arguments = {"pm-radius-sweep", "two"};
+    EXPECT_NE(test::error_of([&] { run_task_command(bad_id, out); }).find("not a task id"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace gilab
