@@ -14,6 +14,7 @@
 #include "core/util/settings.hpp"
 #include "core/util/stats.hpp"
 #include "experiments/runner/experiment.hpp"
+#include "experiments/runner/paper_figures.hpp"
 #include "experiments/runner/path_reference.hpp"
 #include "scenes/builtin_scenes.hpp"
 #include "scenes/scene_library.hpp"
@@ -128,13 +129,20 @@ std::vector<uint8_t> fovea_mask(const EyeCamera& eye, float degrees, bool inside
 // ---------------------------------------------------------------------------------
 // Table 5
 
+// A row of the paper's Table 5 (experiments/papers/p1/table5.csv): photons emitted
+// (side²), radius and the Office's two frame times.
 struct Table5Row {
     int side;
     double radius;
     double separate_ms, reuse_ms;  // paper, Office
 };
-const Table5Row kTable5[] = {{512, 0.05, 15.22, 13.14}, {512, 0.10, 25.01, 22.30}, {512, 0.15, 33.42, 24.52},
-                             {256, 0.05, 11.19, 11.12}, {256, 0.10, 13.97, 11.19}, {256, 0.15, 16.19, 12.73}};
+std::vector<Table5Row> paper_table5() {
+    std::vector<Table5Row> rows;
+    for (const PaperRow& r : paper_figures("p1/table5").rows())
+        rows.push_back({r.integer("photons_side"), r.number("radius"), r.number("eyes_separately ms"),
+                        r.number("stereo_reuse ms")});
+    return rows;
+}
 
 nlohmann::json reuse_figures(const Run& separate, const Run& reuse) {
     nlohmann::json r;
@@ -171,7 +179,7 @@ ExperimentOutput run_table5(const ExperimentContext& ctx) {
         first_rig = rig;
         const ViewSet views = stereo_views(rig);
         const bool office = named.label != "cornell";
-        for (const Table5Row& p : kTable5) {
+        for (const Table5Row& p : paper_table5()) {
             const int side = ctx.quick ? p.side / 2 : p.side;
             nlohmann::json base = {{"photons", side * side}, {"radius", p.radius}};
             nlohmann::json nearest = base, strict = base, fill = base;
@@ -287,7 +295,9 @@ ExperimentOutput run_final(const ExperimentContext& ctx) {
     };
     for (const NamedScene& named : p1_scenes(ctx, out)) {
         const bool office = named.label != "cornell";
-        const Final f = office ? Final{"office", 0.15, 11.96} : Final{"cornell", 0.2, 18.38};
+        // The paper's radius and frame time for this scene (text beside its Figs. 9 and 10).
+        const PaperRow& paper = paper_figures("p1/fig9_10").row({{"scene", office ? "Office" : "Cornell Box"}});
+        const Final f{office ? "office" : "cornell", paper.number("radius"), paper.number("frame ms")};
         const HmdRig rig = vive_rig(named.scene, ctx.quick);
         const ViewSet views = stereo_views(rig);
         nlohmann::json settings = {{"photons", side * side}, {"radius", f.radius}, {"pass", "split"},

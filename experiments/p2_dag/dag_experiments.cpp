@@ -24,6 +24,7 @@
 #include "core/voxel/voxelizer.hpp"
 #include "experiments/runner/experiment.hpp"
 #include "experiments/runner/measures.hpp"
+#include "experiments/runner/paper_figures.hpp"
 #include "scenes/scene_library.hpp"
 
 namespace gilab {
@@ -33,67 +34,60 @@ namespace {
 using nlohmann::json;
 
 // The paper's three models, in its table order; `node` names the model's entry in the
-// scene file (the floor is another entry and is left out of the voxelization).
+// scene file (the floor is another entry and is left out of the voxelization), `paper`
+// its name in the paper's tables.
 struct ModelSpec {
     std::string label;
     std::string scene;
     std::string node;
+    std::string paper;
 };
 
 const std::vector<ModelSpec>& model_specs() {
-    static const std::vector<ModelSpec> specs = {
-        {"Bunny", "bunny", "bunny"}, {"Happy Buddha", "buddha", "buddha"}, {"Dragon", "dragon", "dragon"}};
+    static const std::vector<ModelSpec> specs = {{"Bunny", "bunny", "bunny", "Bunny"},
+                                                 {"Happy Buddha", "buddha", "buddha", "Buddha"},
+                                                 {"Dragon", "dragon", "dragon", "Dragon"}};
     return specs;
 }
 
-// ---- The paper's published figures (reference data, never used as results) ----
+// ---- The paper's published figures (experiments/papers/p2; reference data, never used as results) ----
 
 // Table 1 at 1000³, in units of 10⁴ as printed.
 struct PaperCounts {
     double svo_nodes, svo_pointers, esvo_nodes, esvo_pointers, dag_nodes, dag_pointers;
 };
-std::optional<PaperCounts> paper_table1(const std::string& scene) {
-    if (scene == "bunny") return PaperCounts{2307, 529, 2543, 701, 17.1, 4.8};
-    if (scene == "buddha") return PaperCounts{1577, 438, 1837, 487, 145.1, 43.4};
-    if (scene == "dragon") return PaperCounts{890, 214, 221, 53, 14.2, 3.8};
-    return std::nullopt;
+std::optional<PaperCounts> paper_table1(const std::string& paper_scene) {
+    const PaperRow* r = paper_figures("p2/table1").find({{"scene", paper_scene}});
+    if (!r) return std::nullopt;
+    return PaperCounts{r->number("svo nodes (×10⁴)"),  r->number("svo pointers (×10⁴)"),
+                       r->number("esvo nodes (×10⁴)"), r->number("esvo pointers (×10⁴)"),
+                       r->number("svdag nodes (×10⁴)"), r->number("svdag pointers (×10⁴)")};
 }
 
 // Table 2, MB.
 struct PaperStorage {
     double svo, esvo, svdag;
 };
-std::optional<PaperStorage> paper_table2(const std::string& scene, uint32_t res) {
-    if (scene == "bunny" && res == 512) return PaperStorage{5.82, 31.93, 1.06};
-    if (scene == "bunny" && res == 1000) return PaperStorage{22.42, 123.50, 3.32};
-    if (scene == "buddha" && res == 512) return PaperStorage{3.49, 36.57, 7.44};
-    if (scene == "buddha" && res == 1000) return PaperStorage{13.94, 126.60, 26.30};
-    if (scene == "dragon" && res == 512) return PaperStorage{0.25, 0.47, 0.08};
-    if (scene == "dragon" && res == 1000) return PaperStorage{0.82, 1.49, 0.31};
-    return std::nullopt;
+std::optional<PaperStorage> paper_table2(const std::string& paper_scene, uint32_t res) {
+    const PaperRow* r = paper_figures("p2/table2").find({{"scene", paper_scene}, {"resolution", res}});
+    if (!r) return std::nullopt;
+    return PaperStorage{r->number("svo MB"), r->number("esvo MB"), r->number("svdag MB")};
 }
 
 // Table 3, ms: t_A (whole conversion) and t_B (identical-node search).
 struct PaperTimes {
     double t_a, t_b;
 };
-std::optional<PaperTimes> paper_table3(const std::string& scene, uint32_t res) {
-    static const std::map<std::string, std::map<uint32_t, PaperTimes>> table = {
-        {"bunny", {{128, {6.14, 2.29}}, {256, {24.06, 5.07}}, {512, {250, 30}}, {1000, {1020, 130}}, {2000, {4250, 490}}}},
-        {"buddha", {{128, {8.75, 3.06}}, {256, {33.55, 8.07}}, {512, {340, 40}}, {1000, {1420, 190}}, {2000, {5800, 780}}}},
-        {"dragon",
-         {{128, {11.36, 4.31}}, {256, {40.25, 11.30}}, {512, {400, 50}}, {1000, {1600, 220}}, {2000, {6530, 890}}}}};
-    auto s = table.find(scene);
-    if (s == table.end()) return std::nullopt;
-    auto r = s->second.find(res);
-    if (r == s->second.end()) return std::nullopt;
-    return r->second;
+std::optional<PaperTimes> paper_table3(const std::string& paper_scene, uint32_t res) {
+    const PaperRow* r = paper_figures("p2/table3").find({{"scene", paper_scene}, {"resolution", res}});
+    if (!r) return std::nullopt;
+    return PaperTimes{r->number("t_A ms"), r->number("t_B ms")};
 }
 
 // ---- Models ----
 
 struct Model {
-    std::string label, scene;
+    std::string label, scene, paper;
     std::vector<Vec3> positions;
     std::vector<UVec3> triangles;
     Bounds3 bounds;
@@ -113,6 +107,7 @@ std::shared_ptr<const Model> load_model(const ModelSpec& spec, const AssetPaths&
     auto model = std::make_shared<Model>();
     model->label = spec.label;
     model->scene = spec.scene;
+    model->paper = spec.paper;
     for (const WorldMesh& mesh : frame.meshes) {
         bool inside = false;
         for (int n = int(mesh.node); n >= 0 && !inside; n = scene.nodes[size_t(n)].parent)
@@ -253,7 +248,7 @@ ExperimentOutput run_table1(const ExperimentContext& ctx) {
                     {"svo_over_svdag_nodes", ratio(svo_nodes, dag_nodes)},
                     {"svo_over_svdag_pointers", ratio(svo_ptrs, dag_ptrs)},
                     {"esvo_over_svo_nodes", ratio(esvo_nodes, svo_nodes)}};
-        if (auto p = paper_table1(model->scene)) {
+        if (auto p = paper_table1(model->paper)) {
             row["paper_svo_over_svdag_nodes"] = p->svo_nodes / p->dag_nodes;
             row["paper_svo_over_svdag_pointers"] = p->svo_pointers / p->dag_pointers;
             row["paper_esvo_over_svo_nodes"] = p->esvo_nodes / p->svo_nodes;
@@ -357,7 +352,7 @@ ExperimentOutput run_table2(const ExperimentContext& ctx) {
                         {"octomap_MB", mb(double(s.octomap->bytes()))},
                         {"svo_over_svdag", ratio(svo, dag)},
                         {"esvo_over_svdag", ratio(esvo, dag)}};
-            if (auto p = paper_table2(model->scene, res)) {
+            if (auto p = paper_table2(model->paper, res)) {
                 row["paper_svo_MB"] = p->svo;
                 row["paper_esvo_MB"] = p->esvo;
                 row["paper_svdag_MB"] = p->svdag;
@@ -428,7 +423,7 @@ ExperimentOutput run_table3(const ExperimentContext& ctx) {
         for (uint32_t res : sizes) {
             const VoxelGrid grid = model_grid(*model, res);
             const int reps = repetitions_for(res, ctx.quick);
-            const auto paper = paper_table3(model->scene, res);
+            const auto paper = paper_table3(model->paper, res);
             Voxelizer voxelizer(model->positions, model->triangles, grid);
             const uint64_t estimate = voxelizer.estimate_voxels(grid.full_region());  // about 2× the true count
             auto add_paper = [&](json& row, double t_a_one, double t_a_all) {
@@ -687,6 +682,9 @@ ExperimentOutput run_fig13(const ExperimentContext& ctx) {
     const int size = ctx.quick ? 128 : 512;
     const int reps = ctx.quick ? 3 : 7;
     const double load_at_start = load_average();
+    // Fig. 13 prints no values; the text says the times are about equal.
+    const std::string paper_time_ratio =
+        paper_figures("p2/fig13").row({{"structures", "SVO, ESVO, SVDAG"}}).text("time ratio");
     ExperimentOutput out;
     ResultTable table;
     table.title = "Primary rays (" + std::to_string(size) + "² from the scene camera) through SVO, ESVO and SVDAG at " +
@@ -745,7 +743,7 @@ ExperimentOutput run_fig13(const ExperimentContext& ctx) {
                               {"svdag_over_svo_throughput", ratio(r_dag.mrays_per_s, r_svo.mrays_per_s)},
                               {"esvo_over_svo_throughput", ratio(r_esvo.mrays_per_s, r_svo.mrays_per_s)},
                               {"same_hits_in_all_three", same},
-                              {"paper_time_ratio", "≈ 1 (about equal)"}});
+                              {"paper_time_ratio", paper_time_ratio}});
         const std::string file = "depth_" + model->scene + ".png";
         write_depth_png(ctx.output_dir / file, r_dag.hits, size, size);
         out.files.push_back(file);

@@ -3,10 +3,8 @@
 // build time and peak memory of both build modes (Table 5), and the frame rate of ray
 // casting through the multi-frame DAG along the animation (Table 6).
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <fstream>
-#include <map>
 #include <optional>
 #include "accel/temporal/difference_tree.hpp"
 #include "accel/temporal/minimal_bit_dag.hpp"
@@ -23,6 +21,7 @@
 #include "core/voxel/voxelizer.hpp"
 #include "experiments/runner/experiment.hpp"
 #include "experiments/runner/measures.hpp"
+#include "experiments/runner/paper_figures.hpp"
 #include "scenes/scene_library.hpp"
 #include "accel/temporal/animation_dag.hpp"
 #include "techniques/technique.hpp"
@@ -43,26 +42,24 @@ std::string paper_scene_of(const std::string& scene) {
     return "Fire";
 }
 
-// ---- The paper's published figures (reference data, never used as results) ----
+// ---- The paper's published figures (experiments/papers/p2; reference data, never used as results) ----
 
-// Table 5: N_p (average nodes per frame) and N_n (total nodes) per structure.
+// Table 5: N_p (average nodes per frame) and N_n (total nodes) per structure, in nodes.
 struct PaperCounts {
     double svo_np, svo_nn, diff_np, diff_nn, svdag_np, svdag_nn, tc_np, tc_nn;
 };
-const PaperCounts& paper_table5(const std::string& paper_scene) {
-    // Published as N_p ×10³ and N_n ×10⁶.
-    static const std::map<std::string, PaperCounts> table = {
-        {"Kitchen", {873e3, 685e6, 15.1e3, 1.71e6, 94.8e3, 6.87e6, 5.82e3, 0.36e6}},
-        {"Robot", {321e3, 68.7e6, 224e3, 56.6e6, 50.7e3, 10.0e6, 29.3e3, 7.28e6}},
-        {"Fire", {593e3, 192e6, 433e3, 158e6, 62.1e3, 20.8e6, 44.0e3, 13.66e6}}};
-    return table.at(paper_scene);
+PaperCounts paper_table5(const std::string& paper_scene) {
+    // Published as N_p ×10³ and N_n ×10⁶, multiplied out in decimal.
+    const PaperRow& r = paper_figures("p2/table5").row({{"scene", paper_scene}});
+    auto np = [&](const std::string& s) { return r.scaled(s + " N_p (×10³)", 3); };
+    auto nn = [&](const std::string& s) { return r.scaled(s + " N_n (×10⁶)", 6); };
+    return {np("svo"),   nn("svo"),   np("difference_tree"), nn("difference_tree"),
+            np("svdag"), nn("svdag"), np("time_correlated"), nn("time_correlated")};
 }
 
-// Table 6: CPU frame rate at 1024×768, 800×600 and 400×300.
-double paper_table6_fps(const std::string& paper_scene, int size_index) {
-    static const std::map<std::string, std::array<double, 3>> table = {
-        {"Kitchen", {21.3, 28.1, 62.9}}, {"Robot", {12.0, 16.1, 53.4}}, {"Fire", {6.20, 9.90, 27.1}}};
-    return table.at(paper_scene)[size_t(size_index)];
+// Table 6: CPU frame rate at the paper's image size ("1024×768", "800×600", "400×300").
+double paper_table6_fps(const std::string& paper_scene, const std::string& paper_size) {
+    return paper_figures("p2/table6").row({{"scene", paper_scene}, {"image (pixels)", paper_size}}).number("fps");
 }
 
 // Kämpe et al. 2016: 70 frames of a captured performer at 2048³ in 1.86 MBytes.
@@ -208,7 +205,7 @@ double estimate_kampe_bytes(const Table5Figures& at512) {
 
 void add_table5_rows(const OpenedDynamicScene& s, const Table5Figures& f, ResultTable& counts, ResultTable& storage,
                      ResultTable& builds) {
-    const PaperCounts& p = paper_table5(s.paper_scene);
+    const PaperCounts p = paper_table5(s.paper_scene);
     const double frames = double(f.frames);
     const double tc_nn = double(f.tc.node_count());
     json c;
@@ -499,7 +496,7 @@ ExperimentOutput run_table6(const ExperimentContext& ctx) {
                 }
                 const double fps = all.median_ms > 0 ? 1000.0 / all.median_ms : 0;
                 const double fps1 = one.median_ms > 0 ? 1000.0 / one.median_ms : 0;
-                const double paper_fps = paper_table6_fps(s.paper_scene, int(i));
+                const double paper_fps = paper_table6_fps(s.paper_scene, size.paper_size);
                 json row;
                 row["scene"] = s.name;
                 row["paper scene"] = s.paper_scene;

@@ -17,6 +17,7 @@
 #include "core/util/stats.hpp"
 #include "experiments/runner/experiment.hpp"
 #include "experiments/runner/measures.hpp"
+#include "experiments/runner/paper_figures.hpp"
 #include "scenes/scene_library.hpp"
 #include "techniques/technique.hpp"
 
@@ -36,42 +37,24 @@ const std::vector<ShadowSceneSpec>& shadow_scenes() {
     return specs;
 }
 
-// ---- The paper's published figures (reference data, never used as results) ----
+// ---- The paper's published figures (experiments/papers/p2; reference data, never used as results) ----
 
 // Table 4, MB: S1 shadow map, S2 shadow SVDAG, S3 SVDAG + double depth maps.
 struct PaperStorage {
     double s1, s2, s3;
 };
 std::optional<PaperStorage> paper_table4(const std::string& paper_scene, uint32_t res) {
-    static const std::map<std::string, std::map<uint32_t, PaperStorage>> table = {
-        {"Citadel",
-         {{1000, {2.30, 0.493, 0.231}},
-          {2000, {9.27, 1.62, 0.532}},
-          {4000, {37.20, 5.10, 1.23}},
-          {16000, {605.72, 47.47, 6.46}},
-          {32000, {2422, 127.14, 13.87}}}},
-        {"Villa",
-         {{1000, {2.30, 0.462, 0.146}},
-          {2000, {9.27, 2.47, 0.336}},
-          {4000, {37.20, 7.78, 0.772}},
-          {16000, {605.72, 85.29, 4.09}},
-          {32000, {2422, 249.04, 9.40}}}},
-        {"Terrain",
-         {{1000, {2.30, 0.592, 0.538}},
-          {2000, {9.27, 2.37, 2.03}},
-          {4000, {37.20, 7.50, 6.64}},
-          {16000, {605.72, 91.20, 81.59}},
-          {32000, {2422, 183.23, 163.92}}}}};
-    auto s = table.find(paper_scene);
-    if (s == table.end()) return std::nullopt;
-    auto r = s->second.find(res);
-    if (r == s->second.end()) return std::nullopt;
-    return r->second;
+    const PaperRow* r = paper_figures("p2/table4").find({{"scene", paper_scene}, {"resolution", res}});
+    if (!r) return std::nullopt;
+    return PaperStorage{r->number("S1 MB"), r->number("S2 MB"), r->number("S3 MB")};
 }
 
-// Figs. 16–18 give one figure in the text: on Citadel the double-depth SVDAG's shadow
-// time is 67.9 % below the shadow map's on average.
-constexpr double kPaperCitadelS3VsShadowMap = -67.9;
+// Figs. 16–18 give one figure in the text: on Citadel the double-depth SVDAG's (S3)
+// shadow time is 67.9 % below the shadow map's on average. Null for the other scenes.
+json paper_s3_vs_shadow_map(const std::string& paper_scene) {
+    const PaperRow* r = paper_figures("p2/fig16_18").find({{"scene", paper_scene}, {"structure", "S3"}});
+    return r ? json(r->number("mean vs shadow map (%)")) : json(nullptr);
+}
 
 json paper_or_null(const std::optional<PaperStorage>& p, double PaperStorage::*field) {
     return p ? json((*p).*field) : json(nullptr);
@@ -455,9 +438,7 @@ ExperimentOutput run_fig16_18(const ExperimentContext& ctx) {
             row["mean vs shadow map (%)"] = map_mean > 0 ? json(100.0 * (mean(ms[vi]) / map_mean - 1.0)) : json(nullptr);
             row["pixels differing from rays (%)"] = vi == 0 ? json(0.0) : json(mean(differ[vi]));
             row["paper mean vs shadow map (%)"] =
-                spec.paper_scene == "Citadel" && v.visibility == "shadow_dag_double_depth"
-                    ? json(kPaperCitadelS3VsShadowMap)
-                    : json(nullptr);
+                v.visibility == "shadow_dag_double_depth" ? paper_s3_vs_shadow_map(spec.paper_scene) : json(nullptr);
             summary.rows.push_back(row);
             PlotSeries series{v.label, {}, ms[vi], false, true, int(vi)};
             for (int f = 0; f < frames; ++f) series.x.push_back(f);

@@ -28,6 +28,7 @@
 #include "core/voxel/voxelizer.hpp"
 #include "experiments/runner/experiment.hpp"
 #include "experiments/runner/measures.hpp"
+#include "experiments/runner/paper_figures.hpp"
 #include "experiments/runner/path_reference.hpp"
 #include "scenes/builtin_scenes.hpp"
 #include "scenes/scene_library.hpp"
@@ -330,56 +331,31 @@ const std::vector<SceneFigures>& structure_figures(const ExperimentContext& ctx,
     return it->second;
 }
 
-// Paper figures: [scene][resolution index][structure] for the static (Tables 1, 3, 5)
-// and dynamic (2, 4, 6) scenes. MSVO/SVO memory etc. as printed.
-struct PaperCell {
-    double voxels_m, ms, mb;
-};
-using PaperTable = std::map<std::string, std::map<std::string, std::array<PaperCell, 2>>>;
-const PaperTable& paper_static() {
-    static const PaperTable t = {
-        {"bunny",
-         {{"3D texture", {{{2.097, 14.96, 2}, {16.78, 43.22, 16}}}},
-          {"SVO", {{{0.189, 56.17, 1.584}, {3.604, 96.41, 12.67}}}},
-          {"MSVO", {{{0.176, 53.26, 1.679}, {3.455, 92.34, 13.44}}}},
-          {"SVDAG", {{{0.133, 62.71, 0.951}, {2.562, 135.51, 7.602}}}},
-          {"cascaded", {{{0.098, 5.179, 0.56}, {0.131, 6.872, 0.75}}}}}},
-        {"dragon",
-         {{"3D texture", {{{2.097, 15.36, 2}, {16.78, 42.75, 16}}}},
-          {"SVO", {{{0.113, 46.81, 1.32}, {2.364, 80.34, 10.56}}}},
-          {"MSVO", {{{0.101, 44.29, 1.79}, {2.178, 76.67, 11.98}}}},
-          {"SVDAG", {{{0.891, 53.24, 0.924}, {1.855, 109.44, 3.392}}}},
-          {"cascaded", {{{0.098, 4.316, 0.56}, {0.131, 5.727, 0.75}}}}}},
-        {"buddha",
-         {{"3D texture", {{{2.097, 16.16, 2}, {16.78, 45.65, 16}}}},
-          {"SVO", {{{0.166, 60.85, 1.726}, {3.215, 104.4, 13.21}}}},
-          {"MSVO", {{{0.151, 58.54, 1.878}, {2.986, 101.3, 14.43}}}},
-          {"SVDAG", {{{0.125, 72.86, 1.295}, {2.411, 166.0, 9.247}}}},
-          {"cascaded", {{{0.131, 5.611, 0.56}, {0.164, 7.445, 0.75}}}}}},
-    };
-    return t;
-}
-const PaperTable& paper_dynamic() {
-    static const PaperTable t = {
-        {"sponza",
-         {{"3D texture", {{{16.78, 51.29, 16}, {134.2, 230.1, 128}}}},
-          {"SVO", {{{3.135, 88.48, 6.06}, {6.032, 280.8, 48.48}}}},
-          {"MSVO", {{{2.885, 86.96, 7.07}, {5.766, 275.4, 50.87}}}},
-          {"SVDAG", {{{2.445, 105.1, 4.545}, {4.705, 336.3, 35.98}}}},
-          {"cascaded", {{{0.131, 6.889, 0.75}, {0.164, 8.549, 0.94}}}}}},
-        {"sibenik",
-         {{"3D texture", {{{16.78, 52.11, 16}, {134.2, 233.8, 128}}}},
-          {"SVO", {{{2.916, 98.19, 6.908}, {5.489, 314.5, 54.29}}}},
-          {"MSVO", {{{2.598, 96.78, 7.106}, {5.247, 309.7, 56.86}}}},
-          {"SVDAG", {{{2.225, 115.1, 5.388}, {4.282, 384.4, 43.35}}}},
-          {"cascaded", {{{0.131, 7.716, 0.75}, {0.164, 9.575, 0.94}}}}}},
-    };
-    return t;
-}
-
 std::string model_of(const std::string& scene_name) {
     auto plus = scene_name.find('+');
     return plus == std::string::npos ? scene_name : scene_name.substr(plus + 1);
+}
+
+// The paper's figures for one scene, structure and resolution (experiments/papers/p3):
+// voxels (×10⁶, Tables 1–2), voxelization time (ms, Tables 3–4) and memory (MB as
+// printed, Tables 5–6), of the static scenes (Tables 1, 3, 5) or the dynamic ones (2, 4,
+// 6); nullopt where the paper has none (another resolution, OpenVDB).
+struct PaperCell {
+    double voxels_m, ms, mb;
+};
+std::optional<PaperCell> paper_cell(bool sponza_and_sibenik, const std::string& model, const std::string& structure,
+                                    int resolution) {
+    static const std::map<std::string, std::string> paper_scene = {
+        {"bunny", "Bunny"}, {"dragon", "Dragon"}, {"buddha", "Buddha"}, {"sponza", "Sponza"}, {"sibenik", "Sibenik"}};
+    auto scene = paper_scene.find(model);
+    if (scene == paper_scene.end()) return std::nullopt;
+    const PaperKeys key = {{"scene", scene->second}, {"resolution", resolution}, {"structure", structure}};
+    const int first = sponza_and_sibenik ? 2 : 1;  // the voxel-count table of the set
+    const PaperRow* voxels = paper_figures("p3/table" + std::to_string(first)).find(key);
+    if (!voxels) return std::nullopt;
+    return PaperCell{voxels->number("voxels (×10⁶)"),
+                     paper_figures("p3/table" + std::to_string(first + 2)).row(key).number("voxelize ms"),
+                     paper_figures("p3/table" + std::to_string(first + 4)).row(key).number("memory MB")};
 }
 
 // What a structure table reports: voxel counts (Tables 1–2), voxelization times (3–4) or
@@ -402,7 +378,6 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, SceneSet set, Str
     ExperimentOutput out;
     const bool sponza_and_sibenik = set == SceneSet::SponzaAndSibenik;
     const auto& figures = structure_figures(ctx, set, out);
-    const PaperTable& paper = sponza_and_sibenik ? paper_dynamic() : paper_static();
     // The Stanford models' table is 1, 3 or 5; Sponza and Sibenik's is the next one.
     const int models_table = quantity == StructureQuantity::VoxelCount         ? 1
                              : quantity == StructureQuantity::VoxelizationTime ? 3
@@ -432,14 +407,10 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, SceneSet set, Str
         const std::string model = model_of(sf.scene);
         // The paper's resolution pair: 128/256 (static), 256/512 (Sponza); quick runs use
         // half those and are compared with the paper's first column only when they match.
-        const int paper_first = sponza_and_sibenik ? 256 : 128;
-        int column = sf.resolution == paper_first ? 0 : sf.resolution == 2 * paper_first ? 1 : -1;
         for (const std::string& s : kStructures) {
             const StructureFigures& f = sf.by_structure.at(s);
             nlohmann::json r = {{"scene", sf.scene}, {"resolution", std::to_string(sf.resolution) + "³"}, {"structure", s}};
-            std::optional<PaperCell> p;
-            if (column >= 0 && paper.count(model) && paper.at(model).count(s))
-                p = paper.at(model).at(s)[size_t(column)];
+            const std::optional<PaperCell> p = paper_cell(sponza_and_sibenik, model, s, sf.resolution);
             switch (quantity) {
                 case StructureQuantity::VoxelCount:
                     r["voxels_millions"] = f.voxels / 1e6;
@@ -474,12 +445,11 @@ ExperimentOutput structure_table(const ExperimentContext& ctx, SceneSet set, Str
         ratio.title = "Speed-up of the cascaded voxelization over the dense 3D texture (same run)";
         ratio.columns = {"scene", "resolution", "dense_over_cascaded", "paper dense_over_cascaded"};
         for (const SceneFigures& sf : figures) {
-            const int paper_first = sponza_and_sibenik ? 256 : 128;
-            int column = sf.resolution == paper_first ? 0 : sf.resolution == 2 * paper_first ? 1 : -1;
             const std::string model = model_of(sf.scene);
+            const auto dense = paper_cell(sponza_and_sibenik, model, "3D texture", sf.resolution);
+            const auto cascaded = paper_cell(sponza_and_sibenik, model, "cascaded", sf.resolution);
             nlohmann::json pr;
-            if (column >= 0 && paper.count(model))
-                pr = paper.at(model).at("3D texture")[size_t(column)].ms / paper.at(model).at("cascaded")[size_t(column)].ms;
+            if (dense && cascaded) pr = dense->ms / cascaded->ms;
             ratio.rows.push_back({{"scene", sf.scene},
                                   {"resolution", std::to_string(sf.resolution) + "³"},
                                   {"dense_over_cascaded", sf.by_structure.at("3D texture").ms / sf.by_structure.at("cascaded").ms},
@@ -658,15 +628,17 @@ ExperimentOutput run_table7(const ExperimentContext& ctx) {
     ResultTable t;
     t.title = "Table 7 — per-frame time by phase (ms), Sponza, dense mip VCT vs cascaded";
     t.columns = {"phase", "dense_ms", "cascaded_ms", "cascaded_over_dense", "paper VXGI_ms", "paper cascaded_ms"};
-    const std::map<std::string, std::pair<double, double>> paper = {
-        {"primary_ms", {1.0, 1.0}},   {"injection_ms", {16.5, 12.1}}, {"direct_ms", {3.0, 1.8}},
-        {"diffuse_ms", {9.2, 6.5}},   {"specular_ms", {8.0, 5.2}},    {"total_ms", {36.7, 26.5}},
-        {"update_ms", {15.5, 2.0}}};
+    // Our phases as the paper's Table 7 names them (its dynamic update is from the text).
+    const std::map<std::string, std::string> paper_phase = {
+        {"primary_ms", "rasterize"}, {"injection_ms", "light injection"}, {"direct_ms", "direct lighting"},
+        {"diffuse_ms", "diffuse"},   {"specular_ms", "specular"},          {"total_ms", "total"},
+        {"update_ms", "dynamic update"}};
     for (const char* k : kPhases) {
         const bool update = std::string(k) == "update_ms";
         const double d = update ? median(walk_update[0]) : median(times[0][k]);
         const double c = update ? median(walk_update[1]) : median(times[1][k]);
-        auto p = paper.at(k);
+        const PaperRow& paper = paper_figures("p3/table7").row({{"phase", paper_phase.at(k)}});
+        const std::pair<double, double> p = {paper.number("VXGI ms"), paper.number("cascaded ms")};
         const std::string phase = update ? "update_ms (per frame on the walk, not in the total)"
                                   : std::string(k) == "total_ms" ? "total_ms (without the update)"
                                                                  : std::string(k);
@@ -795,6 +767,8 @@ ExperimentOutput run_fig9(const ExperimentContext& ctx) {
     ResultTable summary;
     summary.title = "Fig. 9 summary — mean over each walk (first frame excluded: every variant starts from a full build)";
     summary.columns = {"scene", "variant", "frame_ms", "update_ms", "injection_ms", "fps", "paper"};
+    // Fig. 9 prints no values: the paper's findings from its text.
+    const PaperFigures& fig9 = paper_figures("p3/fig9");
     for (const CameraWalkRuns& w : walk_runs) {
         const auto& runs = w.runs;
         ResultTable t;
@@ -822,10 +796,12 @@ ExperimentOutput run_fig9(const ExperimentContext& ctx) {
         out.plots.push_back({"fig9_" + w.scene, std::move(plot)});
         for (const CameraWalkRun& r : runs) {
             const double ms = mean(after_first(r.total_ms));
-            const char* paper = r.name == "dense mip"                   ? "VXGI ≈ 10 fps below cascaded + strategy"
-                                : r.name == "cascaded, update strategy" ? "fastest; update ≈ 2.0 ms vs VXGI 15.5 ms"
-                                : r.name == "photon mapping"            ? "PM (and LPV) 5–20 fps"
-                                                                        : "slightly faster than VXGI";
+            // The paper's finding for the curve this variant stands for.
+            const char* curve = r.name == "dense mip"                   ? "VXGI"
+                                : r.name == "cascaded, update strategy" ? "cascaded with update strategy"
+                                : r.name == "photon mapping"            ? "PM"
+                                                                        : "cascaded without update strategy";
+            const std::string paper = fig9.row({{"curve", curve}}).text("finding");
             summary.rows.push_back({{"scene", w.scene},
                                     {"variant", r.name},
                                     {"frame_ms", ms},
@@ -837,7 +813,8 @@ ExperimentOutput run_fig9(const ExperimentContext& ctx) {
         const double everything = mean(after_first(runs[1].update_ms)), strategy = mean(after_first(runs[2].update_ms));
         summary.rows.push_back({{"scene", w.scene}, {"variant", "update time: everything ÷ strategy"}, {"frame_ms", nullptr},
                                 {"update_ms", strategy > 0 ? everything / strategy : 0.0}, {"injection_ms", nullptr},
-                                {"fps", nullptr}, {"paper", "15.5 / 2.0 = 7.8 (VXGI vs cascaded)"}});
+                                {"fps", nullptr},
+                                {"paper", fig9.row({{"curve", "update time VXGI / cascaded"}}).text("finding")}});
     }
     out.tables.push_back(summary);
     nlohmann::json walks = nlohmann::json::object();
@@ -862,6 +839,12 @@ ExperimentOutput run_fig10(const ExperimentContext& ctx) {
     ResultTable summary;
     summary.title = "Fig. 10 summary — mean structure memory over each walk, each variant ÷ dense";
     summary.columns = {"scene", "variant", "mean structure (MB)", "over_dense", "paper over_dense"};
+    // Fig. 10 prints no values: its text gives the cascades' memory as about 40 % of VXGI's.
+    auto paper_over_dense = [](const std::string& variant) {
+        const char* curve = variant == "dense mip" ? "VXGI" : variant.starts_with("cascaded") ? "cascaded" : nullptr;
+        if (!curve) return nlohmann::json();
+        return nlohmann::json(paper_figures("p3/fig10").row({{"curve", curve}}).number("memory over VXGI"));
+    };
     for (const CameraWalkRuns& w : walk_runs) {
         const auto& runs = w.runs;
         ResultTable t;
@@ -892,9 +875,7 @@ ExperimentOutput run_fig10(const ExperimentContext& ctx) {
                                     {"variant", r.name},
                                     {"mean structure (MB)", mb(mean(r.bytes))},
                                     {"over_dense", mean(r.bytes) / mean(runs[0].bytes)},
-                                    {"paper over_dense", r.name == "dense mip"                   ? nlohmann::json(1.0)
-                                                         : r.name.starts_with("cascaded")        ? nlohmann::json(0.4)
-                                                                                                 : nlohmann::json()}});
+                                    {"paper over_dense", paper_over_dense(r.name)}});
     }
     out.tables.push_back(summary);
     out.notes.push_back("Structure memory = every attribute array the technique holds (dense: both radiance mip chains "

@@ -1,0 +1,51 @@
+# Writes OUTPUT, a C++ source holding every experiments/papers/**/*.csv under ROOT as a
+# byte array, named by its path under ROOT without ".csv" ("p1/table1"), for
+# experiments/runner/paper_figures.cpp. Run at build time by experiments/CMakeLists.txt
+# (cmake -DROOT=... -DOUTPUT=... -P paper_figures.cmake). The output is rewritten only
+# when it changes, so an unchanged set of files compiles nothing.
+if(NOT ROOT OR NOT OUTPUT)
+  message(FATAL_ERROR "paper_figures.cmake: pass -DROOT=<papers folder> -DOUTPUT=<source to write>")
+endif()
+file(GLOB_RECURSE files RELATIVE ${ROOT} ${ROOT}/*.csv)
+list(SORT files)
+
+set(arrays "")
+set(entries "")
+set(index 0)
+foreach(relative ${files})
+  file(READ ${ROOT}/${relative} hex HEX)
+  string(LENGTH "${hex}" hex_length)
+  math(EXPR size "${hex_length} / 2")
+  # Sixteen bytes to a line.
+  set(bytes "")
+  set(offset 0)
+  while(offset LESS hex_length)
+    string(SUBSTRING "${hex}" ${offset} 32 chunk)
+    string(REGEX REPLACE "([0-9a-f][0-9a-f])" "0x\\1," chunk "${chunk}")
+    string(APPEND bytes "${chunk}\n    ")
+    math(EXPR offset "${offset} + 32")
+  endwhile()
+  string(REGEX REPLACE "\\.csv$" "" name "${relative}")
+  string(APPEND arrays "// ${relative}\nconst unsigned char file_${index}[] = {\n    ${bytes}0x00};\n")
+  string(APPEND entries "        {\"${name}\", file_${index}, ${size}},\n")
+  math(EXPR index "${index} + 1")
+endforeach()
+
+set(text "// Generated from experiments/papers/**/*.csv by experiments/runner/paper_figures.cmake; do not edit.\n")
+string(APPEND text "#include \"experiments/runner/paper_figures.hpp\"\n\nnamespace gilab::detail {\n\nnamespace {\n")
+string(APPEND text "${arrays}")
+string(APPEND text "}  // namespace\n\nstd::span<const EmbeddedPaperFile> embedded_paper_files() {\n")
+if(index EQUAL 0)
+  string(APPEND text "    return {};\n")
+else()
+  string(APPEND text "    static const EmbeddedPaperFile files[] = {\n${entries}    };\n    return files;\n")
+endif()
+string(APPEND text "}\n\n}  // namespace gilab::detail\n")
+
+set(old "")
+if(EXISTS ${OUTPUT})
+  file(READ ${OUTPUT} old)
+endif()
+if(NOT old STREQUAL text)
+  file(WRITE ${OUTPUT} "${text}")
+endif()
