@@ -1,5 +1,5 @@
 // P1 on the headset: Table 5 (both eyes, eyes separately vs stereo reuse), the final
-// renders of Fig. 11 with their frame times, and the foveated gather the paper leaves as
+// renders of Figs. 9–11 with their frame times, and the foveated gather the paper leaves as
 // future work. Every variant is a setting of the `photon` technique on an HMD stereo
 // pair (HTC Vive preset, the scene's fixed head pose); variants of a row are prepared
 // once and rendered in turn frame by frame, figures are medians over the frames.
@@ -278,14 +278,14 @@ ExperimentOutput run_table5(const ExperimentContext& ctx) {
 }
 
 // ---------------------------------------------------------------------------------
-// Final renders (Fig. 11)
+// Final renders (Figs. 9–11: frame times of Figs. 9 and 10, layers of Fig. 11)
 
 ExperimentOutput run_final(const ExperimentContext& ctx) {
     ExperimentOutput out;
     const int frames = ctx.quick ? 2 : 5;
     const int side = ctx.quick ? 256 : 512;
     ResultTable t;
-    t.title = "Final renders (Fig. 11): both eyes with stereo reuse; left eye against a path-traced reference";
+    t.title = "Final renders (Figs. 9–11): both eyes with stereo reuse; left eye against a path-traced reference";
     t.columns = {"scene",         "photons",       "r",           "frame_ms",     "left_ms",
                  "right_ms",      "reuse_fraction", "relmse_color", "relmse_direct", "relmse_indirect",
                  "reference_spp", "paper ms"};
@@ -442,7 +442,7 @@ void register_stereo_experiments(ExperimentRegistry& registry) {
                   "Table 5: both eyes, eyes separately vs stereo reuse (nearest and strict), Cornell and Office; "
                   "reuse vs IPD and distance",
                   run_table5});
-    registry.add({"pm-final", "P1", "Fig. 11: final stereo renders with global/direct/indirect layers vs path tracing",
+    registry.add({"pm-final", "P1", "Figs. 9–11: final stereo renders with global/direct/indirect layers vs path tracing",
                   run_final});
     registry.add({"pm-foveated", "P1", "Foveated gather (the paper's future work): time vs error in and out of the fovea",
                   run_foveated});
