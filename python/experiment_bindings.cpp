@@ -10,6 +10,7 @@
 #include "core/util/parallel.hpp"
 #include "experiments/runner/experiment.hpp"
 #include "experiments/runner/experiment_batch.hpp"
+#include "experiments/runner/task_command.hpp"
 #include "python/array_helpers.hpp"
 #include "python/bindings.hpp"
 
@@ -87,16 +88,14 @@ void register_experiment_bindings(py::module_& m) {
     m.def(
         "experiment_plan",
         [](const std::string& name, bool quick) {
-            const Experiment& experiment = ExperimentRegistry::builtin().get(name);
-            if (!experiment.spec)
-                throw Error(name, "this experiment is not declared as a spec, so it has no task plan");
+            const Experiment& experiment = declared_experiment_named(name);
             py::list tasks;
             for (const SpecTask& t : plan_tasks(*experiment.spec, quick)) tasks.append(json_to_python(t.to_json()));
             return tasks;
         },
         "name"_a, "quick"_a = true,
         "The tasks of a declared experiment as dicts (id, scene, variant, technique, axes, settings), as `gilab "
-        "experiment plan NAME`.");
+        "experiment plan NAME --quick` (quick=False: the full plan, as without --quick).");
 
     m.def(
         "run_experiment",

@@ -1,5 +1,7 @@
 #include "techniques/technique.hpp"
 
+#include <algorithm>
+
 #include "core/util/error.hpp"
 #include "techniques/dag_raycast/dag_raycast_technique.hpp"
 #include "techniques/dag_shadows/dag_shadows_technique.hpp"
@@ -13,6 +15,9 @@ void TechniqueRegistry::add(TechniqueInfo info) {
     if (info.name.empty()) throw Error("technique registry", "a technique needs a name");
     if (!info.create) throw Error("technique registry", "technique '" + info.name + "' has no factory");
     if (!info.settings_schema) throw Error("technique registry", "technique '" + info.name + "' has no settings schema");
+    const auto& specs = info.settings_schema().specs();
+    if (std::count_if(specs.begin(), specs.end(), [](const SettingSpec& s) { return s.knob.has_value(); }) > 1)
+        throw Error("technique registry", "technique '" + info.name + "' declares more than one quality knob");
     if (find(info.name)) throw Error("technique registry", "technique '" + info.name + "' is registered twice");
     techniques_.push_back(std::move(info));
 }

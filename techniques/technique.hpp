@@ -66,7 +66,8 @@ private:
 
 // The set-up every caller of a technique repeats. prepare_technique creates the built-in
 // technique `name` (an unknown name is an Error listing the known ones), prepares it for
-// `scene` with `settings`, then reports the settings it never read; the second form
+// `scene` with `settings` after checking every key against the technique's settings
+// schema, then reports the settings it never read; the second form
 // prepares a technique already made. Errors name the settings' context (the caller)
 // and, for unread keys, the technique.
 std::unique_ptr<Technique> prepare_technique(const std::string& name, const Scene& scene, const Settings& settings);

@@ -208,6 +208,24 @@ void SettingsSchema::check_known(const Settings& settings) const {
     throw Error(settings.context(), msg.str());
 }
 
+void SettingsSchema::check_range(const Settings& settings, const SettingSpec& s, double v) const {
+    const bool low_ok = s.low_exclusive ? v > s.low : v >= s.low;
+    const bool high_ok = s.high_exclusive ? v < s.high : v <= s.high;
+    if (!low_ok || !high_ok)
+        throw Error(settings.context(), "setting '" + s.key + "' must be " + requirement_text(s) +
+                                            (s.unit.empty() ? "" : " (" + s.unit + ")") + ", got " +
+                                            value_text(settings.json().at(s.key)) +
+                                            (value_text(settings.json().at(s.key)) == number_as_given(v)
+                                                 ? ""
+                                                 : " (" + number_as_given(v) + " as stored)"));
+}
+
+void SettingsSchema::check_values(const Settings& settings) const {
+    check_known(settings);
+    for (const SettingSpec& s : specs_)
+        if (settings.has(s.key)) (void)checked(settings, s);
+}
+
 nlohmann::json SettingsSchema::checked(const Settings& settings, const SettingSpec& s) const {
     const std::string& where = settings.context();
     const std::string name = "setting '" + s.key + "'";
@@ -215,13 +233,8 @@ nlohmann::json SettingsSchema::checked(const Settings& settings, const SettingSp
         case SettingType::Integer:
         case SettingType::Number: {
             // Settings::get checks the JSON type, finiteness and (integers) wholeness and fit.
-            const double v = s.type == SettingType::Integer ? double(settings.get<int64_t>(s.key, 0))
-                                                            : settings.get<double>(s.key, 0.0);
-            const bool low_ok = s.low_exclusive ? v > s.low : v >= s.low;
-            const bool high_ok = s.high_exclusive ? v < s.high : v <= s.high;
-            if (!low_ok || !high_ok)
-                throw Error(where, name + " must be " + requirement_text(s) + (s.unit.empty() ? "" : " (" + s.unit + ")") +
-                                       ", got " + value_text(settings.json().at(s.key)));
+            check_range(settings, s, s.type == SettingType::Integer ? double(settings.get<int64_t>(s.key, 0))
+                                                                    : settings.get<double>(s.key, 0.0));
             return settings.json().at(s.key);
         }
         case SettingType::Boolean: return settings.get<bool>(s.key, false);

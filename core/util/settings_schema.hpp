@@ -97,6 +97,9 @@ public:
     // Throws Error naming every given key the schema does not declare, with the nearest
     // declared key when one is close, and where to find the list.
     void check_known(const Settings& settings) const;
+    // check_known, and every given value checked for type, range and choices (what a
+    // parser checks key by key; the checks that join keys stay the parser's).
+    void check_values(const Settings& settings) const;
 
     // The value of `key`: the default when the setting is not given, else the given value
     // checked for type, range and choices (Error naming the setting otherwise). Marks the
@@ -136,10 +139,20 @@ private:
     }
     template <typename T>
     T given(const Settings& settings, const SettingSpec& s) const {
-        // Settings::get checks that the number fits T (1e10 read as an int is refused).
-        if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) (void)settings.get<T>(s.key, T{});
-        return checked(settings, s).template get<T>();
+        // The declared range first (its message says what the setting takes), then that
+        // the number fits T (1e10 read as an int is refused by Settings::get), then, for a
+        // float, the range again on the value as stored (1e-50 is > 0 but 0 as a float).
+        nlohmann::json value = checked(settings, s);
+        if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) {
+            const T narrowed = settings.get<T>(s.key, T{});
+            if constexpr (std::is_floating_point_v<T>) check_range(settings, s, double(narrowed));
+            return narrowed;
+        } else {
+            return value.template get<T>();
+        }
     }
+    // Throws Error naming the setting unless `value` lies in its declared range.
+    void check_range(const Settings& settings, const SettingSpec& spec, double value) const;
     // The given value, checked against the spec; a Choice given as a boolean is mapped
     // through its aliases.
     nlohmann::json checked(const Settings& settings, const SettingSpec& spec) const;

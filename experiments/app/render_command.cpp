@@ -243,11 +243,31 @@ HeadPose pose_from_camera(const SceneCamera& c) {
     return {eye.position(), eye.orientation()};
 }
 
+namespace {
+
+// Everything the technique's schema can tell before a scene is loaded: --spp and
+// --time-budget need the settings they set, and every --set key must be declared.
+void check_settings_against_schema(const Technique& technique, const RenderRequest& request, const Settings& settings) {
+    // --spp is stored as the setting 'spp'; a technique that declares no such setting
+    // takes no pixel samples, which is the option's fault, not an unknown --set key.
+    const SettingsSchema& schema = TechniqueRegistry::builtin().find(technique.name())->settings_schema();
+    if (request.spp && !schema.declares("spp"))
+        throw Error("--spp", "technique '" + technique.name() +
+                                 "' takes no pixel samples (it has no setting 'spp'); leave --spp out");
+    if (request.time_budget && !schema.declares("time_budget"))
+        throw Error("--time-budget", "technique '" + technique.name() +
+                                         "' takes no time budget (it has no setting 'time_budget'); leave --time-budget out");
+    check_settings_known(technique, settings);
+}
+
+}  // namespace
+
 TechniqueAndRig begin_render(const RenderRequest& request) {
     check_options(request);
     TechniqueAndRig setup;
     setup.technique = TechniqueRegistry::builtin().create(request.technique);  // fail fast on a bad name
     setup.settings = read_settings(request);
+    check_settings_against_schema(*setup.technique, request, setup.settings);
     if (request.hmd) setup.rig = HmdRig(find_hmd_preset(*request.hmd));  // before loading: bad preset fails fast
     if (request.width && request.height) check_resolution(*request.width, *request.height);
     else if (request.width || request.height) throw Error("--width/--height", "give both or neither");
@@ -275,16 +295,6 @@ ViewSet aim_views(TechniqueAndRig& setup, const RenderRequest& request, const Sc
 void prepare_render(TechniqueAndRig& setup, const RenderRequest& request, const Scene& scene) {
     Technique& technique = *setup.technique;
     const Settings& settings = setup.settings;
-    // --spp is stored as the setting 'spp'; a technique that declares no such setting
-    // takes no pixel samples, which is the option's fault, not an unknown --set key.
-    const SettingsSchema& schema = TechniqueRegistry::builtin().find(technique.name())->settings_schema();
-    if (request.spp && !schema.declares("spp"))
-        throw Error("--spp", "technique '" + technique.name() +
-                                 "' takes no pixel samples (it has no setting 'spp'); leave --spp out");
-    if (request.time_budget && !schema.declares("time_budget"))
-        throw Error("--time-budget", "technique '" + technique.name() +
-                                         "' takes no time budget (it has no setting 'time_budget'); leave --time-budget out");
-    check_settings_known(technique, settings);
     technique.prepare(scene, settings);
     report_unused_settings(technique, settings);
 }

@@ -113,6 +113,9 @@ std::string reason_to_rerun(const fs::path& experiment_dir, bool quick, uint64_t
     if (doc.value("quick", !quick) != quick) return quick ? "finished without --quick" : "finished with --quick";
     if (doc.value("seed", seed + 1) != seed) return "finished with another seed";
     if (doc.value("threads", -1) != resolved_threads(threads)) return "finished with another thread count";
+    if (doc.contains("config") && doc["config"].contains("effective") &&
+        !doc["config"]["effective"].value("tasks_missing", nlohmann::json::array()).empty())
+        return "merged from some of its tasks only";
     return "";
 }
 

@@ -93,6 +93,10 @@ std::vector<SpecTask> plan_tasks(const ExperimentSpec& spec, bool quick) {
                 t.axes = point;
                 t.settings = v.settings;
                 for (auto it = point.begin(); it != point.end(); ++it) t.settings[it.key()] = it.value();
+                // Values are checked here, for every task, so a bad axis value stops the plan,
+                // not the run after hours.
+                TechniqueRegistry::builtin().find(v.technique)->settings_schema().check_values(
+                    Settings(t.settings, "experiment spec '" + spec.name + "', task " + std::to_string(t.id)));
                 tasks.push_back(std::move(t));
             }
     return tasks;

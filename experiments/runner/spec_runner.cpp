@@ -19,9 +19,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// The middle value; the mean of the two middle ones for an even count.
 double median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
     std::sort(v.begin(), v.end());
-    return v.empty() ? 0.0 : v[v.size() / 2];
+    const size_t h = v.size() / 2;
+    return v.size() % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]);
 }
 
 int size_of(const ExperimentSpec& s, bool quick) { return quick ? s.quick_size : s.size; }
@@ -33,15 +36,46 @@ EyeCamera spec_camera(const Scene& scene, int size) {
     return EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, size, size);
 }
 
-// What identifies a task's work: a result file must match it to be merged.
-nlohmann::json task_identity(const SpecTask& t, bool quick, uint64_t seed) {
-    return {{"task", t.to_json()}, {"quick", quick}, {"seed", seed}};
+// What identifies a task's work: a result file must match it to be merged. The sizes
+// and measures come from the spec, so a spec changed since the task ran is caught.
+nlohmann::json task_identity(const ExperimentSpec& spec, const SpecTask& t, bool quick, uint64_t seed) {
+    nlohmann::json measures = nlohmann::json::array();
+    for (const SpecMeasure& m : spec.measures) measures.push_back({m.column, m.key, int(m.source)});
+    return {{"quick", quick},
+            {"seed", seed},
+            {"task", t.to_json()},
+            {"size", size_of(spec, quick)},
+            {"frames", frames_of(spec, quick)},
+            {"reference_spp", spec.needs_reference() ? reference_spp_of(spec, quick) : 0},
+            {"measure_list", measures}};
+}
+
+// Why `result` (read from `file`) is not task `t`'s, or "" when it is.
+std::string identity_mismatch(const nlohmann::json& result, const nlohmann::json& identity, bool quick) {
+    if (!result.contains("quick") || result["quick"] != identity["quick"])
+        return std::string("it was written ") + (quick ? "without" : "with") + " --quick; merge " +
+               (quick ? "without" : "with") + " --quick to use it";
+    if (!result.contains("seed") || result["seed"] != identity["seed"])
+        return "it was written with --seed " + result.value("seed", nlohmann::json()).dump() + ", not " +
+               identity["seed"].dump();
+    for (const char* key : {"task", "size", "frames", "reference_spp", "measure_list"})
+        if (!result.contains(key) || result[key] != identity[key])
+            return std::string("its '") + key + "' differs from this plan's (the spec changed since it ran); run the "
+                                                "task again";
+    return "";
+}
+
+// An axis's table column: its setting with the unit the technique's schema gives it.
+std::string axis_column(const ExperimentSpec& spec, const SpecAxis& axis) {
+    const TechniqueInfo* info = TechniqueRegistry::builtin().find(spec.variants.at(0).technique);
+    const SettingSpec& setting = info->settings_schema().spec(axis.setting);
+    return setting.unit.empty() ? axis.setting : axis.setting + " (" + setting.unit + ")";
 }
 
 }  // namespace
 
-fs::path spec_task_file(const fs::path& output_dir, int task_id) {
-    return output_dir / "tasks" / (std::to_string(task_id) + ".json");
+fs::path spec_task_file(const fs::path& output_dir, int task_id, bool quick) {
+    return output_dir / "tasks" / (quick ? "quick" : "full") / (std::to_string(task_id) + ".json");
 }
 
 nlohmann::json run_spec_task(const ExperimentSpec& spec, int task_id, const ExperimentContext& ctx) {
@@ -49,7 +83,8 @@ nlohmann::json run_spec_task(const ExperimentSpec& spec, int task_id, const Expe
     if (task_id < 0 || task_id >= int(tasks.size()))
         throw Error(spec.name, "no task " + std::to_string(task_id) + " in the " + (ctx.quick ? "quick " : "") +
                                    "plan (tasks 0 to " + std::to_string(tasks.size() - 1) +
-                                   "; `gilab experiment plan " + spec.name + "` lists them)");
+                                   "; `gilab experiment plan " + spec.name + (ctx.quick ? " --quick" : "") +
+                                   "` lists them)");
     const SpecTask& task = tasks[size_t(task_id)];
     fs::create_directories(ctx.output_dir);  // the reference cache and tasks/ live there
     const int size = size_of(spec, ctx.quick), frames = frames_of(spec, ctx.quick);
@@ -85,14 +120,15 @@ nlohmann::json run_spec_task(const ExperimentSpec& spec, int task_id, const Expe
             }
         }
     }
-    nlohmann::json result = task_identity(task, ctx.quick, ctx.seed);
+    nlohmann::json result = task_identity(spec, task, ctx.quick, ctx.seed);
     result["frames"] = frames;
     result["size"] = size;
     result["measures"] = measures;
     result["per_frame"] = per_frame;
     result["git_revision"] = git_revision();
     result["threads"] = ctx.threads > 0 ? ctx.threads : int(machine_description()["tbb_threads"]);
-    const fs::path file = spec_task_file(ctx.output_dir, task.id);
+    result["machine"] = machine_description().value("cpu", std::string("unknown CPU"));
+    const fs::path file = spec_task_file(ctx.output_dir, task.id, ctx.quick);
     fs::create_directories(file.parent_path());
     write_file_atomically(file, result.dump(2) + "\n");
     return result;
@@ -104,15 +140,15 @@ ExperimentOutput merge_spec_tasks(const ExperimentSpec& spec, const ExperimentCo
     ResultTable table;
     table.title = spec.figure + " — " + spec.description;
     table.columns = {"scene"};
-    for (const SpecAxis& a : spec.axes) table.columns.push_back(a.setting);
+    for (const SpecAxis& a : spec.axes) table.columns.push_back(axis_column(spec, a));
     table.columns.push_back("variant");
     for (const SpecMeasure& m : spec.measures) table.columns.push_back(m.column);
     table.columns.push_back("frames");
 
     std::vector<int> missing;
-    std::set<std::string> revisions, threads;
+    std::set<std::string> revisions, threads, machines;
     for (const SpecTask& task : tasks) {
-        const fs::path file = spec_task_file(ctx.output_dir, task.id);
+        const fs::path file = spec_task_file(ctx.output_dir, task.id, ctx.quick);
         if (!fs::exists(file)) {
             missing.push_back(task.id);
             continue;
@@ -124,25 +160,27 @@ ExperimentOutput merge_spec_tasks(const ExperimentSpec& spec, const ExperimentCo
         } catch (const nlohmann::json::exception& e) {
             throw Error(file.string(), std::string("not a task result: ") + e.what());
         }
-        const nlohmann::json identity = task_identity(task, ctx.quick, ctx.seed);
-        for (const char* key : {"task", "quick", "seed"})
-            if (!result.contains(key) || result[key] != identity[key])
-                throw Error(file.string(), std::string("written for another plan (its '") + key +
-                                               "' differs from task " + std::to_string(task.id) + " of the " +
-                                               (ctx.quick ? "quick " : "") + "plan with seed " +
-                                               std::to_string(ctx.seed) + "); remove it or run the task again");
+        const std::string mismatch = identity_mismatch(result, task_identity(spec, task, ctx.quick, ctx.seed), ctx.quick);
+        if (!mismatch.empty())
+            throw Error(file.string(), "not a result of task " + std::to_string(task.id) + " of this plan: " + mismatch);
         nlohmann::json row;
         row["scene"] = task.scene;
-        for (auto it = task.axes.begin(); it != task.axes.end(); ++it) row[it.key()] = it.value();
+        for (const SpecAxis& a : spec.axes) row[axis_column(spec, a)] = task.axes.at(a.setting);
         row["variant"] = task.variant;
-        for (const SpecMeasure& m : spec.measures) row[m.column] = result.at("measures").at(m.column);
-        row["frames"] = result.at("frames");
+        try {
+            for (const SpecMeasure& m : spec.measures) row[m.column] = result.at("measures").at(m.column);
+            row["frames"] = result.at("frames");
+        } catch (const nlohmann::json::exception&) {
+            throw Error(file.string(), "a task result without every measure of the spec; run the task again");
+        }
+        machines.insert(result.value("machine", std::string("unknown")));
         table.rows.push_back(std::move(row));
         revisions.insert(result.value("git_revision", std::string("unknown")));
         threads.insert(std::to_string(result.value("threads", 0)));
     }
     if (table.rows.empty())
-        throw Error(spec.name, "no task has run yet (" + (ctx.output_dir / "tasks").string() + " holds none of the " +
+        throw Error(spec.name, "no task has run yet (" + spec_task_file(ctx.output_dir, 0, ctx.quick).parent_path().string() +
+                                   " holds none of the " +
                                    std::to_string(tasks.size()) + " tasks)");
     out.tables.push_back(std::move(table));
     out.config = spec.to_json();
@@ -151,6 +189,11 @@ ExperimentOutput merge_spec_tasks(const ExperimentSpec& spec, const ExperimentCo
                                {"frames", frames_of(spec, ctx.quick)},
                                {"tasks", tasks.size()}};
     if (spec.needs_reference()) out.config["effective"]["reference_spp"] = reference_spp_of(spec, ctx.quick);
+    out.config["effective"]["tasks_merged"] = tasks.size() - missing.size();
+    out.config["effective"]["tasks_missing"] = missing;
+    out.config["effective"]["task_revisions"] = revisions;
+    out.config["effective"]["task_threads"] = threads;
+    out.config["effective"]["task_machines"] = machines;
     out.notes = spec.notes;
     if (!missing.empty()) {
         std::string list;
@@ -158,20 +201,25 @@ ExperimentOutput merge_spec_tasks(const ExperimentSpec& spec, const ExperimentCo
         out.notes.push_back("Incomplete: " + std::to_string(missing.size()) + " of " + std::to_string(tasks.size()) +
                             " tasks have not run (" + list + ").");
     }
-    if (revisions.size() > 1 || threads.size() > 1) {
-        std::string r, t;
-        for (const auto& s : revisions) r += (r.empty() ? "" : ", ") + s;
-        for (const auto& s : threads) t += (t.empty() ? "" : ", ") + s;
-        out.notes.push_back("Tasks ran at more than one revision or thread count (revisions " + r + "; threads " + t +
-                            "): times are comparable only within one.");
-    }
+    auto joined = [](const std::set<std::string>& values) {
+        std::string out;
+        for (const auto& v : values) out += (out.empty() ? "" : ", ") + v;
+        return out;
+    };
+    out.notes.push_back("Merged from " + std::to_string(tasks.size() - missing.size()) + " task files (" +
+                        spec_task_file(ctx.output_dir, 0, ctx.quick).parent_path().filename().string() +
+                        " plan) measured at revision " + joined(revisions) + " with " + joined(threads) +
+                        " threads on " + joined(machines) + "; the header above names the merging run.");
+    if (revisions.size() > 1 || threads.size() > 1 || machines.size() > 1)
+        out.notes.push_back("Tasks ran at more than one revision, thread count or machine: times are comparable only "
+                            "within one.");
     return out;
 }
 
 ExperimentOutput run_spec(const ExperimentSpec& spec, const ExperimentContext& ctx) {
     const std::vector<SpecTask> tasks = plan_tasks(spec, ctx.quick);
     // A fresh run: task files of an earlier run would be merged as if from this one.
-    fs::remove_all(ctx.output_dir / "tasks");
+    fs::remove_all(spec_task_file(ctx.output_dir, 0, ctx.quick).parent_path());
     for (const SpecTask& task : tasks) run_spec_task(spec, task.id, ctx);
     return merge_spec_tasks(spec, ctx);
 }

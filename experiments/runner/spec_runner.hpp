@@ -1,7 +1,7 @@
 #pragma once
 // The generic runner of declared experiments (experiment_spec.hpp): a task is prepared
 // through prepare_technique, rendered `frames` times and measured; its raw result goes
-// atomically to results/NAME/tasks/ID.json on its own, so tasks can run anywhere (one
+// atomically to results/NAME/tasks/{full|quick}/ID.json on its own, so tasks can run anywhere (one
 // by one, on several machines, as a job array) and be merged afterwards. Running the
 // whole experiment is plan, every task, then merge.
 #include <filesystem>
@@ -12,16 +12,19 @@
 
 namespace gilab {
 
-// results/NAME/tasks/ID.json under the experiment's output directory.
-std::filesystem::path spec_task_file(const std::filesystem::path& output_dir, int task_id);
+// results/NAME/tasks/{full|quick}/ID.json under the experiment's output directory: the
+// quick and the full plan number their tasks each from 0.
+std::filesystem::path spec_task_file(const std::filesystem::path& output_dir, int task_id, bool quick);
 
 // Runs task `task_id` of the plan (ctx.quick chooses the plan) and writes its result
 // file; returns the result. Throws Error naming the task for an id outside the plan.
 nlohmann::json run_spec_task(const ExperimentSpec& spec, int task_id, const ExperimentContext& ctx);
 
 // Reduces the task files in ctx.output_dir/tasks into the experiment's tables. Refuses
-// a task file written for another plan (another --quick, spec or task order) naming the
-// file; tasks not run yet are listed in a note, and no task at all is an Error.
+// a task file written for another plan (another --quick, --seed, spec or task order)
+// naming the file; tasks not run yet are listed in a note and in the config's
+// effective.tasks_missing (such a merge is not a finished run for --resume), and no task
+// at all is an Error.
 ExperimentOutput merge_spec_tasks(const ExperimentSpec& spec, const ExperimentContext& ctx);
 
 // Plan, run every task, merge: what `gilab experiment NAME` does for a declared one.

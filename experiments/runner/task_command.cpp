@@ -7,9 +7,9 @@
 
 namespace gilab {
 
-namespace {
+namespace fs = std::filesystem;
 
-const Experiment& declared(const std::string& name) {
+const Experiment& declared_experiment_named(const std::string& name) {
     const Experiment& e = ExperimentRegistry::builtin().get(name);  // throws listing the known ones
     if (!e.spec) {
         std::string declared_ones;
@@ -20,6 +20,8 @@ const Experiment& declared(const std::string& name) {
     }
     return e;
 }
+
+namespace {
 
 int task_id(const std::string& text) {
     int id = -1;
@@ -36,7 +38,7 @@ int run_task_command(const TaskCommand& c, std::ostream& out) {
     if (c.arguments.size() != wanted)
         throw Error(c.verb, c.verb == "run-task" ? "needs an experiment name and a task id: run-task NAME ID"
                                                  : "needs one experiment name: " + c.verb + " NAME");
-    const Experiment& e = declared(c.arguments[0]);
+    const Experiment& e = declared_experiment_named(c.arguments[0]);
     if (c.verb == "plan") {
         for (const SpecTask& t : plan_tasks(*e.spec, c.quick)) out << t.to_json().dump() << "\n";
         return 0;
@@ -51,9 +53,14 @@ int run_task_command(const TaskCommand& c, std::ostream& out) {
     if (c.verb == "run-task") {
         const int id = task_id(c.arguments[1]);
         run_spec_task(*e.spec, id, ctx);
-        out << "wrote " << spec_task_file(ctx.output_dir, id).string() << "\n";
+        out << "wrote " << spec_task_file(ctx.output_dir, id, ctx.quick).string() << "\n";
         return 0;
     }
+    const fs::path tasks = spec_task_file(ctx.output_dir, 0, ctx.quick).parent_path();
+    if (!fs::is_directory(tasks))
+        throw Error(tasks.string(), "no such directory: no task of the " + std::string(c.quick ? "quick" : "full") +
+                                        " plan has run under " + c.results_root.string() +
+                                        " (run-task writes there; check --results and --quick)");
     Experiment merging = e;
     merging.run = [&e](const ExperimentContext& context) { return merge_spec_tasks(*e.spec, context); };
     run_and_write(merging, ctx);

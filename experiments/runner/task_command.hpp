@@ -20,8 +20,13 @@ struct TaskCommand {
     AssetPaths assets;
 };
 
+// The registered experiment `name` if it is declared as a spec; else an Error saying it
+// runs only whole and naming the declared ones.
+struct Experiment;
+const Experiment& declared_experiment_named(const std::string& name);
+
 // plan: one JSON line per task (id, scene, variant, technique, axes, settings).
-// run-task: runs task ID and writes RESULTS/NAME/tasks/ID.json.
+// run-task: runs task ID and writes RESULTS/NAME/tasks/{full|quick}/ID.json.
 // merge: writes RESULTS/NAME/results.csv, results.json and table.md from the tasks there.
 // Returns the exit code; errors (an experiment that is not declared as a spec, a bad id)
 // are thrown as Error.

@@ -38,6 +38,15 @@ std::string error_of(const SettingsSchema& schema, const nlohmann::json& given, 
     return "";
 }
 
+std::string test_float_error(const SettingsSchema& schema, const nlohmann::json& given) {
+    try {
+        schema.get<float>(Settings(given, "cfg"), given.begin().key());
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "";
+}
+
 TEST(SettingsSchema, DefaultsComeFromTheDeclaration) {
     const SettingsSchema schema = example();
     const Settings empty;
@@ -77,6 +86,15 @@ TEST(SettingsSchema, GivenValuesAreChecked) {
               std::string::npos);
     EXPECT_NE(error_of(schema, {{"mode", 3}}, "mode").find("'mode' must be one of"), std::string::npos);
     EXPECT_NE(error_of(schema, {{"name", 3}}, "name").find("wrong type"), std::string::npos);
+    // The declared range is what a message names, before the fit of the C++ type.
+    EXPECT_NE(error_of(schema, {{"levels", -5}}, "levels").find("'levels' must be 1 to 16, got -5"), std::string::npos);
+    // A float is checked as stored: 1e-50 is positive, but not as a float.
+    const std::string tiny = test_float_error(schema, {{"alpha", 1e-50}});
+    EXPECT_NE(tiny.find("'alpha' must be in (0, 1), got 1e-50 (0 as stored)"), std::string::npos) << tiny;
+    // check_values checks every given value at once.
+    EXPECT_NO_THROW(schema.check_values(Settings(nlohmann::json{{"spp", 3}, {"mode", "paper"}})));
+    EXPECT_THROW(schema.check_values(Settings(nlohmann::json{{"spp", 3}, {"mode", "on"}})), Error);
+    EXPECT_THROW(schema.check_values(Settings(nlohmann::json{{"spq", 3}})), Error);
     // Booleans of older settings files stand for choices.
     EXPECT_EQ(schema.get<std::string>(Settings(nlohmann::json{{"mode", true}}), "mode"), "cell_groups");
     EXPECT_EQ(schema.get<std::string>(Settings(nlohmann::json{{"mode", false}}), "mode"), "off");

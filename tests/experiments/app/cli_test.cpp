@@ -57,6 +57,54 @@ TEST(Cli, ListShowsTechniquesExperimentsScenesAndPresets) {
     for (const char* name : {"path", "core-rays", "cornell", "vive"}) EXPECT_TRUE(contains(r.output, name)) << name;
 }
 
+TEST(Cli, ListSettingsPrintsEachTechniquesSchema) {
+    for (const char* technique : {"path", "photon", "vct", "dag_shadows", "dag_raycast"}) {
+        const Result r = run(std::string("list settings ") + technique);
+        ASSERT_EQ(r.exit_code, 0) << r.output;
+        EXPECT_TRUE(contains(r.output, std::string(technique) + ": ")) << r.output;
+        EXPECT_TRUE(contains(r.output, "tile_size")) << technique;
+    }
+    EXPECT_TRUE(contains(run("list settings photon").output, "(searched in 1024 … 67108864)"));
+    EXPECT_TRUE(contains(run("list settings vct --markdown").output, "| `diffuse_cones` | integer | 16 |"));
+    const Result unknown = run("list settings photons");
+    EXPECT_NE(unknown.exit_code, 0);
+    EXPECT_TRUE(contains(unknown.output, "unknown technique")) << unknown.output;
+    const Result misplaced = run("list scenes --markdown");
+    EXPECT_NE(misplaced.exit_code, 0);
+    EXPECT_TRUE(contains(misplaced.output, "go with `gilab list settings` only")) << misplaced.output;
+}
+
+TEST(Cli, DeclaredExperimentsRunTaskByTaskAndMerge) {
+    const fs::path dir = gilab::test::temp_dir("cli_tasks");
+    const Result plan = run("experiment plan pm-radius-sweep --quick");
+    ASSERT_EQ(plan.exit_code, 0) << plan.output;
+    EXPECT_EQ(std::count(plan.output.begin(), plan.output.end(), '\n'), 4) << plan.output;
+    const std::string results = " --quick --results " + dir.string();
+    const Result task = run("experiment run-task pm-radius-sweep 1" + results);
+    if (contains(task.output, "not found")) GTEST_SKIP() << task.output;  // the conference room is a shared asset
+    ASSERT_EQ(task.exit_code, 0) << task.output;
+    EXPECT_TRUE(fs::exists(dir / "pm-radius-sweep" / "tasks" / "quick" / "1.json"));
+    const Result merge = run("experiment merge pm-radius-sweep" + results);
+    ASSERT_EQ(merge.exit_code, 0) << merge.output;
+    std::ifstream table(dir / "pm-radius-sweep" / "table.md");
+    const std::string text((std::istreambuf_iterator<char>(table)), std::istreambuf_iterator<char>());
+    EXPECT_TRUE(contains(text, "3 of 4 tasks have not run (0, 2, 3)")) << text;
+    // An incomplete merge is not a finished run: --resume runs the experiment again.
+    const Result resumed = run("experiment pm-radius-sweep --resume" + results);
+    EXPECT_TRUE(contains(resumed.output, "running again (merged from some of its tasks only)")) << resumed.output;
+    for (const auto& [args, message] :
+         std::vector<std::pair<std::string, std::string>>{{"experiment run-task pm-radius-sweep 4" + results, "no task 4"},
+                                                          {"experiment run-task pm-radius-sweep x" + results, "not a task id"},
+                                                          {"experiment run-task pm-radius-sweep" + results, "needs an experiment name and a task id"},
+                                                          {"experiment plan pm-table1", "not declared as a spec"},
+                                                          {"experiment merge pm-radius-sweep --results " + (dir / "none").string(), "no such directory"}}) {
+        const Result r = run(args);
+        EXPECT_NE(r.exit_code, 0) << args;
+        EXPECT_TRUE(contains(r.output, message)) << args << "\n" << r.output;
+    }
+    EXPECT_FALSE(fs::exists(dir / "none"));  // a failed merge creates nothing
+}
+
 TEST(Cli, InfoDescribesTheCornellBox) {
     Result r = run("info cornell");
     ASSERT_EQ(r.exit_code, 0) << r.output;

@@ -19,7 +19,7 @@ TEST(RadiusSweep, QuickRunMeasuresEveryTaskAndMorePhotonsLowerTheError) {
     for (const auto& row : rows) {
         EXPECT_GT(row.at("frame_ms").get<double>(), 0.0) << row.dump();
         EXPECT_GT(row.at("photons_stored").get<double>(), 0.0) << row.dump();
-        error[row.at("radius").get<double>()][row.at("photons").get<int>()] = row.at("relmse_indirect").get<double>();
+        error[row.at("radius (scene units)").get<double>()][row.at("photons (emitted per frame)").get<int>()] = row.at("relmse_indirect").get<double>();
     }
     ASSERT_EQ(error.size(), 2u);
     for (const auto& [radius, by_photons] : error) {

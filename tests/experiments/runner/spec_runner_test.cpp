@@ -83,12 +83,13 @@ TEST(SpecRunner, TasksRunSeparatelyMergeIntoTheTablesOfTheWholeRun) {
     ASSERT_EQ(merged.tables.size(), 1u);
     const ResultTable &a = whole.tables[0], &b = merged.tables[0];
     EXPECT_EQ(a.columns, b.columns);
-    EXPECT_EQ(a.columns, (std::vector<std::string>{"scene", "photons", "radius", "variant", "frame_ms",
-                                                   "photons_stored", "relmse_color", "frames"}));
+    EXPECT_EQ(a.columns, (std::vector<std::string>{"scene", "photons (emitted per frame)", "radius (scene units)",
+                                                   "variant", "frame_ms", "photons_stored", "relmse_color", "frames"}));
     ASSERT_EQ(a.rows.size(), 4u);
     ASSERT_EQ(b.rows.size(), 4u);
     for (size_t i = 0; i < a.rows.size(); ++i) {
-        for (const char* key : {"scene", "photons", "radius", "variant", "photons_stored", "relmse_color", "frames"})
+        for (const char* key : {"scene", "photons (emitted per frame)", "radius (scene units)", "variant",
+                                "photons_stored", "relmse_color", "frames"})
             EXPECT_EQ(a.rows[i].at(key), b.rows[i].at(key)) << key << " in row " << i;
         EXPECT_GT(a.rows[i].at("frame_ms").get<double>(), 0.0);
         EXPECT_GT(b.rows[i].at("frame_ms").get<double>(), 0.0);
@@ -99,6 +100,18 @@ TEST(SpecRunner, TasksRunSeparatelyMergeIntoTheTablesOfTheWholeRun) {
     EXPECT_EQ(a.rows[0].at("photons_stored"), a.rows[1].at("photons_stored"));
     EXPECT_EQ(whole.config.at("name"), "test-sweep");
     EXPECT_EQ(whole.config.at("effective").at("tasks"), 4);
+}
+
+size_t merged_rows(const ExperimentSpec& spec, const fs::path& dir, bool quick) {
+    return merge_spec_tasks(spec, context(dir, quick)).tables.at(0).rows.size();
+}
+
+TEST(SpecRunner, AnAxisValueOutsideTheSchemaStopsThePlan) {
+    ExperimentSpec bad = cornell_spec();
+    bad.axes[1].quick = {0.1, -1};
+    const std::string error = test::error_of([&] { plan_tasks(bad, true); });
+    EXPECT_NE(error.find("setting 'radius' must be positive"), std::string::npos) << error;
+    EXPECT_NO_THROW(plan_tasks(bad, false));  // the full plan has no such value
 }
 
 TEST(SpecRunner, MergeListsMissingTasksAndRefusesAnotherPlansFiles) {
@@ -112,10 +125,26 @@ TEST(SpecRunner, MergeListsMissingTasksAndRefusesAnotherPlansFiles) {
     bool listed = false;
     for (const std::string& note : partial.notes) listed |= note.find("3 of 4 tasks have not run (0, 1, 3)") != std::string::npos;
     EXPECT_TRUE(listed);
-    // The quick plan's task 2 is not the full plan's task 2.
+    EXPECT_EQ(partial.config.at("effective").at("tasks_missing"), (json{0, 1, 3}));
+    // The quick plan's tasks are not the full plan's: they are kept apart.
     const std::string error = test::error_of([&] { merge_spec_tasks(spec, context(dir, false)); });
-    EXPECT_NE(error.find("2.json"), std::string::npos) << error;
-    EXPECT_NE(error.find("written for another plan"), std::string::npos) << error;
+    EXPECT_NE(error.find("tasks/full holds none of the 4 tasks"), std::string::npos) << error;
+    EXPECT_EQ(merged_rows(spec, dir, true), 1u);
+    // A task file of another spec (more frames) is refused, naming the file and the reason.
+    ExperimentSpec more_frames = spec;
+    more_frames.quick_frames = 3;
+    const std::string changed = test::error_of([&] { merge_spec_tasks(more_frames, context(dir)); });
+    EXPECT_NE(changed.find("2.json"), std::string::npos) << changed;
+    EXPECT_NE(changed.find("'frames' differs"), std::string::npos) << changed;
+    // A task file from another --quick is named as such.
+    fs::create_directories(dir / "tasks" / "full");
+    fs::copy_file(dir / "tasks" / "quick" / "2.json", dir / "tasks" / "full" / "2.json");
+    const std::string other_quick = test::error_of([&] { merge_spec_tasks(spec, context(dir, false)); });
+    EXPECT_NE(other_quick.find("written with --quick; merge with --quick"), std::string::npos) << other_quick;
+    // A file cut short is refused naming it.
+    std::ofstream(dir / "tasks" / "quick" / "0.json") << "{\"quick\": tr";
+    EXPECT_NE(test::error_of([&] { merge_spec_tasks(spec, context(dir)); }).find("0.json: not a task result"),
+              std::string::npos);
     EXPECT_NE(test::error_of([&] { run_spec_task(spec, 4, context(dir)); }).find("no task 4"), std::string::npos);
 }
 
