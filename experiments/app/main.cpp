@@ -151,7 +151,7 @@ int main(int argc, char** argv) {
     auto* experiment = app.add_subcommand(
         "experiment", "run experiments: `list`, a name, several names, or `all`; for a declared experiment also "
                       "`plan NAME` (its tasks as JSON lines), `run-task NAME ID` (one task, written to "
-                      "RESULTS/NAME/tasks/ID.json) and `merge NAME` (the tables from the tasks that exist)");
+                      "RESULTS/NAME/tasks/{full|quick}/ID.json) and `merge NAME` (the tables from the tasks that exist)");
     experiment->add_option("names", experiment_names, "experiment names, `all`, `list`, or plan|run-task|merge NAME [ID]")
         ->required();
     experiment->add_flag("--quick", quick, "small sizes (smoke run, minutes)");

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <map>
 #include <optional>
 #include <set>
 #include "core/image/image_io.hpp"
@@ -78,6 +79,12 @@ fs::path spec_task_file(const fs::path& output_dir, int task_id, bool quick) {
     return output_dir / "tasks" / (quick ? "quick" : "full") / (std::to_string(task_id) + ".json");
 }
 
+namespace {
+// Task `task` on `scene` (already loaded): prepare, render, measure, write its file.
+nlohmann::json run_planned_task(const ExperimentSpec& spec, const SpecTask& task, const Scene& scene,
+                                const ExperimentContext& ctx);
+}  // namespace
+
 nlohmann::json run_spec_task(const ExperimentSpec& spec, int task_id, const ExperimentContext& ctx) {
     const std::vector<SpecTask> tasks = plan_tasks(spec, ctx.quick);
     if (task_id < 0 || task_id >= int(tasks.size()))
@@ -86,10 +93,14 @@ nlohmann::json run_spec_task(const ExperimentSpec& spec, int task_id, const Expe
                                    "; `gilab experiment plan " + spec.name + (ctx.quick ? " --quick" : "") +
                                    "` lists them)");
     const SpecTask& task = tasks[size_t(task_id)];
+    return run_planned_task(spec, task, open_scene(task.scene, ctx.assets).scene, ctx);
+}
+
+namespace {
+nlohmann::json run_planned_task(const ExperimentSpec& spec, const SpecTask& task, const Scene& scene,
+                                const ExperimentContext& ctx) {
     fs::create_directories(ctx.output_dir);  // the reference cache and tasks/ live there
     const int size = size_of(spec, ctx.quick), frames = frames_of(spec, ctx.quick);
-
-    Scene scene = open_scene(task.scene, ctx.assets).scene;
     const EyeCamera camera = spec_camera(scene, size);
     nlohmann::json settings = task.settings;
     if (!settings.contains("seed")) settings["seed"] = ctx.seed;
@@ -126,13 +137,15 @@ nlohmann::json run_spec_task(const ExperimentSpec& spec, int task_id, const Expe
     result["measures"] = measures;
     result["per_frame"] = per_frame;
     result["git_revision"] = git_revision();
-    result["threads"] = ctx.threads > 0 ? ctx.threads : int(machine_description()["tbb_threads"]);
-    result["machine"] = machine_description().value("cpu", std::string("unknown CPU"));
+    const nlohmann::json machine = machine_description();
+    result["threads"] = ctx.threads > 0 ? ctx.threads : int(machine["tbb_threads"]);
+    result["machine"] = machine.value("cpu", std::string("unknown CPU"));
     const fs::path file = spec_task_file(ctx.output_dir, task.id, ctx.quick);
     fs::create_directories(file.parent_path());
     write_file_atomically(file, result.dump(2) + "\n");
     return result;
 }
+}  // namespace
 
 ExperimentOutput merge_spec_tasks(const ExperimentSpec& spec, const ExperimentContext& ctx) {
     const std::vector<SpecTask> tasks = plan_tasks(spec, ctx.quick);
@@ -220,7 +233,13 @@ ExperimentOutput run_spec(const ExperimentSpec& spec, const ExperimentContext& c
     const std::vector<SpecTask> tasks = plan_tasks(spec, ctx.quick);
     // A fresh run: task files of an earlier run would be merged as if from this one.
     fs::remove_all(spec_task_file(ctx.output_dir, 0, ctx.quick).parent_path());
-    for (const SpecTask& task : tasks) run_spec_task(spec, task.id, ctx);
+    // One plan, and each scene loaded once for all of its tasks.
+    std::map<std::string, Scene> scenes;
+    for (const SpecTask& task : tasks) {
+        auto loaded = scenes.find(task.scene);
+        if (loaded == scenes.end()) loaded = scenes.emplace(task.scene, open_scene(task.scene, ctx.assets).scene).first;
+        run_planned_task(spec, task, loaded->second, ctx);
+    }
     return merge_spec_tasks(spec, ctx);
 }
 
