@@ -16,7 +16,7 @@ Experiment radius_sweep_experiment() {
         .size = 256, .quick_size = 48,
         .frames = 3, .quick_frames = 1,
         .reference_spp = 1024, .quick_reference_spp = 32,
-        .variants = {{"hash grid, radius gather", "photon", {{"photon_map", "hash_grid"}, {"gather", "radius"}}}},
+        .variants = {{.name = "hash grid, radius gather", .technique = "photon", .settings = {{"photon_map", "hash_grid"}, {"gather", "radius"}}}},
         .axes = {{"photons", {65536, 262144, 1048576}, {8192, 32768}},
                  {"radius", {0.1, 0.2, 0.4}, {0.15, 0.3}}},
         .measures = {{"frame_ms", Source::FrameStat, "render_ms"},

@@ -9,8 +9,10 @@
 #include "core/image/image_metrics.hpp"
 #include "core/util/error.hpp"
 #include "core/util/stats.hpp"
+#include "experiments/runner/measures.hpp"
 #include "experiments/runner/path_reference.hpp"
 #include "experiments/runner/result_writers.hpp"
+#include "experiments/runner/spec_functions.hpp"
 #include "scenes/scene_library.hpp"
 #include "techniques/technique.hpp"
 
@@ -20,13 +22,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The middle value; the mean of the two middle ones for an even count.
-double median(std::vector<double> v) {
-    if (v.empty()) return 0.0;
-    std::sort(v.begin(), v.end());
-    const size_t h = v.size() / 2;
-    return v.size() % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]);
-}
+using Source = SpecMeasure::Source;
 
 int size_of(const ExperimentSpec& s, bool quick) { return quick ? s.quick_size : s.size; }
 int frames_of(const ExperimentSpec& s, bool quick) { return quick ? s.quick_frames : s.frames; }
@@ -66,75 +62,134 @@ std::string identity_mismatch(const nlohmann::json& result, const nlohmann::json
     return "";
 }
 
-// An axis's table column: its setting with the unit the technique's schema gives it.
-std::string axis_column(const ExperimentSpec& spec, const SpecAxis& axis) {
-    const TechniqueInfo* info = TechniqueRegistry::builtin().find(spec.variants.at(0).technique);
-    const SettingSpec& setting = info->settings_schema().spec(axis.setting);
-    return setting.unit.empty() ? axis.setting : axis.setting + " (" + setting.unit + ")";
+// The columns an axis adds to the default table: its setting, or the keys of its
+// objects, each with the unit the technique's schema gives it.
+std::vector<std::pair<std::string, std::string>> axis_columns(const ExperimentSpec& spec, const SpecAxis& axis) {
+    std::vector<std::string> keys;
+    if (!axis.setting.empty()) keys.push_back(axis.setting);
+    else
+        for (auto it = axis.full.front().begin(); it != axis.full.front().end(); ++it) keys.push_back(it.key());
+    const SettingsSchema* schema = nullptr;
+    for (const SpecVariant& v : spec.variants)
+        if (!v.is_probe()) {
+            schema = &TechniqueRegistry::builtin().find(v.technique)->settings_schema();
+            break;
+        }
+    std::vector<std::pair<std::string, std::string>> columns;  // (setting, column)
+    for (const std::string& key : keys) {
+        std::string unit = schema && schema->declares(key) ? schema->spec(key).unit : "";
+        columns.emplace_back(key, unit.empty() ? key : key + " (" + unit + ")");
+    }
+    return columns;
 }
 
-}  // namespace
-
-fs::path spec_task_file(const fs::path& output_dir, int task_id, bool quick) {
-    return output_dir / "tasks" / (quick ? "quick" : "full") / (std::to_string(task_id) + ".json");
+// A short digest of a layer's floats: equal digests mean bit-identical layers.
+std::string layer_digest(const Film& film, const std::string& layer) {
+    uint64_t h = 1469598103934665603ull;  // FNV-1a over the bytes
+    for (float f : film.layer(layer).data) {
+        const auto* bytes = reinterpret_cast<const unsigned char*>(&f);
+        for (size_t i = 0; i < sizeof f; ++i) h = (h ^ bytes[i]) * 1099511628211ull;
+    }
+    char text[17];
+    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
+    return text;
 }
 
-namespace {
-// Task `task` on `scene` (already loaded): prepare, render, measure, write its file.
-nlohmann::json run_planned_task(const ExperimentSpec& spec, const SpecTask& task, const Scene& scene,
-                                const ExperimentContext& ctx);
-}  // namespace
-
-nlohmann::json run_spec_task(const ExperimentSpec& spec, int task_id, const ExperimentContext& ctx) {
-    const std::vector<SpecTask> tasks = plan_tasks(spec, ctx.quick);
-    if (task_id < 0 || task_id >= int(tasks.size()))
-        throw Error(spec.name, "no task " + std::to_string(task_id) + " in the " + (ctx.quick ? "quick " : "") +
-                                   "plan (tasks 0 to " + std::to_string(tasks.size() - 1) +
-                                   "; `gilab experiment plan " + spec.name + (ctx.quick ? " --quick" : "") +
-                                   "` lists them)");
-    const SpecTask& task = tasks[size_t(task_id)];
-    return run_planned_task(spec, task, open_scene(task.scene, ctx.assets).scene, ctx);
-}
-
-namespace {
-nlohmann::json run_planned_task(const ExperimentSpec& spec, const SpecTask& task, const Scene& scene,
-                                const ExperimentContext& ctx) {
-    fs::create_directories(ctx.output_dir);  // the reference cache and tasks/ live there
-    const int size = size_of(spec, ctx.quick), frames = frames_of(spec, ctx.quick);
+// The technique variants of a task: prepared in turn, then rendered in turn frame by
+// frame (A B C A B C …), each measured as the spec says.
+std::vector<nlohmann::json> run_technique_variants(const ExperimentSpec& spec, const SpecTask& task,
+                                                   const std::vector<const TaskVariant*>& variants, const Scene& scene,
+                                                   const ExperimentContext& ctx, nlohmann::json& per_frame_out) {
+    const int size = size_of(spec, ctx.quick);
     const EyeCamera camera = spec_camera(scene, size);
-    nlohmann::json settings = task.settings;
-    if (!settings.contains("seed")) settings["seed"] = ctx.seed;
-    Settings given(settings, spec.name + " task " + std::to_string(task.id) + " (" + task.variant + ")");
-    ctx.say("task " + std::to_string(task.id) + ": " + task.scene + ", " + task.variant + ", " + task.axes.dump());
-    std::unique_ptr<Technique> technique = prepare_technique(task.technique, scene, given);
-    const Stats prepared = technique->stats();
-
-    std::map<std::string, std::vector<double>> per_frame;
-    std::vector<Film> films;
+    const size_t n = variants.size();
+    std::vector<std::unique_ptr<Technique>> techniques;
+    std::vector<Stats> prepared;
+    for (const TaskVariant* v : variants) {
+        nlohmann::json settings = v->settings;
+        if (!settings.contains("seed")) settings["seed"] = ctx.seed;
+        Settings given(settings, spec.name + " task " + std::to_string(task.id) + " (" + v->name + ")");
+        techniques.push_back(prepare_technique(v->technique, scene, given));
+        prepared.push_back(techniques.back()->stats());
+    }
+    std::vector<std::map<std::string, std::vector<double>>> per_frame(n);
+    std::vector<Stats> last(n);
+    std::vector<Film> films(n);
+    int frames = frames_of(spec, ctx.quick);
     for (int f = 0; f < frames; ++f) {
-        technique->render(ViewSet::mono(camera), films);
-        const Stats stats = technique->stats();
-        for (const SpecMeasure& m : spec.measures)
-            if (m.source == SpecMeasure::Source::FrameStat) per_frame[m.key].push_back(stats.get(m.key));
+        double slowest = 0;
+        for (size_t v = 0; v < n; ++v) {
+            std::vector<Film> out;
+            techniques[v]->render(ViewSet::mono(camera), out);
+            last[v] = techniques[v]->stats();
+            for (const SpecMeasure& m : spec.measures)
+                if (m.source == Source::FrameStat) per_frame[v][m.key].push_back(last[v].get(m.key));
+            slowest = std::max(slowest, last[v].get("render_ms"));
+            films[v] = std::move(out.at(0));
+        }
+        if (f == 0 && spec.slow.frame_ms > 0 && slowest > spec.slow.frame_ms) frames = std::min(frames, spec.slow.frames);
     }
     std::optional<Film> reference;  // rendered (or read from the cache) once per task
-    nlohmann::json measures = nlohmann::json::object();
-    for (const SpecMeasure& m : spec.measures) {
-        switch (m.source) {
-            case SpecMeasure::Source::FrameStat: measures[m.column] = median(per_frame[m.key]); break;
-            case SpecMeasure::Source::PrepareStat: measures[m.column] = prepared.get(m.key); break;
-            case SpecMeasure::Source::RelMse: {
-                std::vector<std::string> files;
-                if (!reference) reference = path_reference(ctx, scene, camera, reference_spp_of(spec, ctx.quick), files);
-                measures[m.column] = relative_mse(films.at(0), *reference, m.key);
-                break;
+    std::vector<nlohmann::json> rows;
+    for (size_t v = 0; v < n; ++v) {
+        nlohmann::json row = {{"variant", variants[v]->name}};
+        for (const SpecMeasure& m : spec.measures) {
+            switch (m.source) {
+                case Source::FrameStat: row[m.column] = median(per_frame[v][m.key]); break;
+                case Source::PrepareStat: row[m.column] = prepared[v].get(m.key); break;
+                case Source::LastFrameStat: row[m.column] = last[v].get(m.key); break;
+                case Source::LayerMean: row[m.column] = mean_value(films[v], m.key); break;
+                case Source::ImageDigest: row[m.column] = layer_digest(films[v], m.key); break;
+                case Source::RelMse: {
+                    std::vector<std::string> files;
+                    if (!reference)
+                        reference = path_reference(ctx, scene, camera, reference_spp_of(spec, ctx.quick), files);
+                    row[m.column] = relative_mse(films[v], *reference, m.key);
+                    break;
+                }
             }
         }
+        row["frames"] = frames;
+        per_frame_out[variants[v]->name] = per_frame[v];
+        rows.push_back(std::move(row));
     }
+    return rows;
+}
+
+// Task `task`: run its variants, write its file.
+nlohmann::json run_planned_task(const ExperimentSpec& spec, const SpecTask& task, TaskCache& cache,
+                                const ExperimentContext& ctx) {
+    fs::create_directories(ctx.output_dir);  // the reference cache and tasks/ live there
+    std::string names;
+    for (const TaskVariant& v : task.variants) names += (names.empty() ? "" : ", ") + v.name;
+    ctx.say("task " + std::to_string(task.id) + ": " + task.scene + ", " + names + ", " + task.axes.dump());
     nlohmann::json result = task_identity(spec, task, ctx.quick, ctx.seed);
-    result["frames"] = frames;
-    result["size"] = size;
-    result["measures"] = measures;
+    nlohmann::json rows = nlohmann::json::array(), notes = nlohmann::json::array(), files = nlohmann::json::array();
+    nlohmann::json per_frame = nlohmann::json::object();
+    std::vector<const TaskVariant*> techniques;
+    for (const TaskVariant& v : task.variants)
+        if (v.probe.empty()) techniques.push_back(&v);
+    if (!techniques.empty()) {
+        const Scene& scene =
+            cache.get<Scene>("scene:" + task.scene, [&] { return open_scene(task.scene, ctx.assets).scene; });
+        for (nlohmann::json& row : run_technique_variants(spec, task, techniques, scene, ctx, per_frame))
+            rows.push_back(std::move(row));
+    }
+    for (const TaskVariant& v : task.variants) {
+        if (v.probe.empty()) continue;
+        const ProbeCall call{spec, task, v, ctx, size_of(spec, ctx.quick), frames_of(spec, ctx.quick),
+                             reference_spp_of(spec, ctx.quick), cache};
+        ProbeOutput out = (*find_probe(v.probe))(call);
+        for (nlohmann::json& row : out.rows) {
+            if (!row.contains("variant")) row["variant"] = v.name;
+            rows.push_back(std::move(row));
+        }
+        for (std::string& note : out.notes) notes.push_back(std::move(note));
+        for (std::string& file : out.files) files.push_back(std::move(file));
+    }
+    result["rows"] = rows;
+    result["notes"] = notes;
+    result["files"] = files;
     result["per_frame"] = per_frame;
     result["git_revision"] = git_revision();
     const nlohmann::json machine = machine_description();
@@ -145,21 +200,69 @@ nlohmann::json run_planned_task(const ExperimentSpec& spec, const SpecTask& task
     write_file_atomically(file, result.dump(2) + "\n");
     return result;
 }
+
+std::string joined(const std::set<std::string>& values) {
+    std::string out;
+    for (const auto& v : values) out += (out.empty() ? "" : ", ") + v;
+    return out;
+}
+
 }  // namespace
 
-ExperimentOutput merge_spec_tasks(const ExperimentSpec& spec, const ExperimentContext& ctx) {
-    const std::vector<SpecTask> tasks = plan_tasks(spec, ctx.quick);
-    ExperimentOutput out;
+ResultTable SpecReduction::default_table() const {
     ResultTable table;
     table.title = spec.figure + " — " + spec.description;
     table.columns = {"scene"};
-    for (const SpecAxis& a : spec.axes) table.columns.push_back(axis_column(spec, a));
+    std::vector<std::pair<std::string, std::string>> axes;
+    for (const SpecAxis& a : spec.axes)
+        for (auto& column : axis_columns(spec, a)) axes.push_back(column);
+    for (const auto& [setting, column] : axes) table.columns.push_back(column);
     table.columns.push_back("variant");
     for (const SpecMeasure& m : spec.measures) table.columns.push_back(m.column);
-    table.columns.push_back("frames");
+    const size_t measured_from = table.columns.size();
+    for (const TaskResult& t : tasks)
+        for (const nlohmann::json& row : t.rows)
+            for (auto it = row.begin(); it != row.end(); ++it)
+                if (it.key() != "variant" && it.key() != "frames" &&
+                    std::find(table.columns.begin() + long(measured_from), table.columns.end(), it.key()) ==
+                        table.columns.end() &&
+                    std::find(table.columns.begin(), table.columns.begin() + long(measured_from), it.key()) ==
+                        table.columns.begin() + long(measured_from))
+                    table.columns.push_back(it.key());
+    if (spec.has_technique_variant()) table.columns.push_back("frames");
+    for (const TaskResult& t : tasks)
+        for (const nlohmann::json& measured : t.rows) {
+            nlohmann::json row = {{"scene", t.task.scene}};
+            for (const auto& [setting, column] : axes) row[column] = t.task.axes.value(setting, nlohmann::json());
+            for (auto it = measured.begin(); it != measured.end(); ++it) row[it.key()] = it.value();
+            for (const std::string& c : table.columns)
+                if (!row.contains(c)) row[c] = nullptr;
+            table.rows.push_back(std::move(row));
+        }
+    return table;
+}
 
+fs::path spec_task_file(const fs::path& output_dir, int task_id, bool quick) {
+    return output_dir / "tasks" / (quick ? "quick" : "full") / (std::to_string(task_id) + ".json");
+}
+
+nlohmann::json run_spec_task(const ExperimentSpec& spec, int task_id, const ExperimentContext& ctx) {
+    const std::vector<SpecTask> tasks = plan_tasks(spec, ctx.quick);
+    if (task_id < 0 || task_id >= int(tasks.size()))
+        throw Error(spec.name, "no task " + std::to_string(task_id) + " in the " + (ctx.quick ? "quick " : "") +
+                                   "plan (tasks 0 to " + std::to_string(tasks.size() - 1) +
+                                   "; `gilab experiment plan " + spec.name + (ctx.quick ? " --quick" : "") +
+                                   "` lists them)");
+    TaskCache cache;
+    return run_planned_task(spec, tasks[size_t(task_id)], cache, ctx);
+}
+
+ExperimentOutput merge_spec_tasks(const ExperimentSpec& spec, const ExperimentContext& ctx) {
+    const std::vector<SpecTask> tasks = plan_tasks(spec, ctx.quick);
+    SpecReduction reduction{spec, ctx, {}};
     std::vector<int> missing;
     std::set<std::string> revisions, threads, machines;
+    std::vector<std::string> task_notes, task_files;
     for (const SpecTask& task : tasks) {
         const fs::path file = spec_task_file(ctx.output_dir, task.id, ctx.quick);
         if (!fs::exists(file)) {
@@ -176,26 +279,36 @@ ExperimentOutput merge_spec_tasks(const ExperimentSpec& spec, const ExperimentCo
         const std::string mismatch = identity_mismatch(result, task_identity(spec, task, ctx.quick, ctx.seed), ctx.quick);
         if (!mismatch.empty())
             throw Error(file.string(), "not a result of task " + std::to_string(task.id) + " of this plan: " + mismatch);
-        nlohmann::json row;
-        row["scene"] = task.scene;
-        for (const SpecAxis& a : spec.axes) row[axis_column(spec, a)] = task.axes.at(a.setting);
-        row["variant"] = task.variant;
+        TaskResult r{task, {}, {}, {}};
         try {
-            for (const SpecMeasure& m : spec.measures) row[m.column] = result.at("measures").at(m.column);
-            row["frames"] = result.at("frames");
+            r.rows = result.at("rows").get<std::vector<nlohmann::json>>();
+            r.notes = result.at("notes").get<std::vector<std::string>>();
+            r.files = result.at("files").get<std::vector<std::string>>();
         } catch (const nlohmann::json::exception&) {
-            throw Error(file.string(), "a task result without every measure of the spec; run the task again");
+            throw Error(file.string(), "a task result without its rows, notes and files; run the task again");
         }
+        for (const nlohmann::json& row : r.rows)
+            for (const SpecMeasure& m : spec.measures)
+                if (!spec.variants.empty() && !row.contains(m.column) && row.contains("frames"))
+                    throw Error(file.string(), "a task result without the measure '" + m.column + "'; run the task again");
+        for (const std::string& note : r.notes)
+            if (std::find(task_notes.begin(), task_notes.end(), note) == task_notes.end()) task_notes.push_back(note);
+        for (const std::string& f : r.files)
+            if (std::find(task_files.begin(), task_files.end(), f) == task_files.end()) task_files.push_back(f);
         machines.insert(result.value("machine", std::string("unknown")));
-        table.rows.push_back(std::move(row));
         revisions.insert(result.value("git_revision", std::string("unknown")));
         threads.insert(std::to_string(result.value("threads", 0)));
+        reduction.tasks.push_back(std::move(r));
     }
-    if (table.rows.empty())
+    if (reduction.tasks.empty())
         throw Error(spec.name, "no task has run yet (" + spec_task_file(ctx.output_dir, 0, ctx.quick).parent_path().string() +
-                                   " holds none of the " +
-                                   std::to_string(tasks.size()) + " tasks)");
-    out.tables.push_back(std::move(table));
+                                   " holds none of the " + std::to_string(tasks.size()) + " tasks)");
+    ExperimentOutput out;
+    if (spec.reducer.empty()) {
+        out.tables.push_back(reduction.default_table());
+    } else {
+        out = (*find_reducer(spec.reducer))(reduction);
+    }
     out.config = spec.to_json();
     out.config["effective"] = {{"quick", ctx.quick},
                                {"size", size_of(spec, ctx.quick)},
@@ -207,18 +320,18 @@ ExperimentOutput merge_spec_tasks(const ExperimentSpec& spec, const ExperimentCo
     out.config["effective"]["task_revisions"] = revisions;
     out.config["effective"]["task_threads"] = threads;
     out.config["effective"]["task_machines"] = machines;
-    out.notes = spec.notes;
+    std::vector<std::string> notes = spec.notes;
+    notes.insert(notes.end(), out.notes.begin(), out.notes.end());
+    notes.insert(notes.end(), task_notes.begin(), task_notes.end());
+    out.notes = std::move(notes);
+    for (const std::string& f : task_files)
+        if (std::find(out.files.begin(), out.files.end(), f) == out.files.end()) out.files.push_back(f);
     if (!missing.empty()) {
         std::string list;
         for (int id : missing) list += (list.empty() ? "" : ", ") + std::to_string(id);
         out.notes.push_back("Incomplete: " + std::to_string(missing.size()) + " of " + std::to_string(tasks.size()) +
                             " tasks have not run (" + list + ").");
     }
-    auto joined = [](const std::set<std::string>& values) {
-        std::string out;
-        for (const auto& v : values) out += (out.empty() ? "" : ", ") + v;
-        return out;
-    };
     out.notes.push_back("Merged from " + std::to_string(tasks.size() - missing.size()) + " task files (" +
                         spec_task_file(ctx.output_dir, 0, ctx.quick).parent_path().filename().string() +
                         " plan) measured at revision " + joined(revisions) + " with " + joined(threads) +
@@ -233,13 +346,10 @@ ExperimentOutput run_spec(const ExperimentSpec& spec, const ExperimentContext& c
     const std::vector<SpecTask> tasks = plan_tasks(spec, ctx.quick);
     // A fresh run: task files of an earlier run would be merged as if from this one.
     fs::remove_all(spec_task_file(ctx.output_dir, 0, ctx.quick).parent_path());
-    // One plan, and each scene loaded once for all of its tasks.
-    std::map<std::string, Scene> scenes;
-    for (const SpecTask& task : tasks) {
-        auto loaded = scenes.find(task.scene);
-        if (loaded == scenes.end()) loaded = scenes.emplace(task.scene, open_scene(task.scene, ctx.assets).scene).first;
-        run_planned_task(spec, task, loaded->second, ctx);
-    }
+    // One plan, one cache: each scene (and whatever else the probes share) is loaded once
+    // for all tasks.
+    TaskCache cache;
+    for (const SpecTask& task : tasks) run_planned_task(spec, task, cache, ctx);
     return merge_spec_tasks(spec, ctx);
 }
 

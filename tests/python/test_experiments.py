@@ -46,6 +46,6 @@ def test_experiment_plan_matches_the_cli(run_cli):
     printed = [json.loads(line) for line in run_cli("experiment", "plan", "pm-radius-sweep", "--quick").stdout.splitlines()]
     assert plan == printed
     assert [t["id"] for t in plan] == list(range(len(plan)))
-    assert {t["technique"] for t in plan} == {"photon"}
+    assert {v["technique"] for t in plan for v in t["variants"]} == {"photon"}
     with pytest.raises(gilab.Error, match="not declared as a spec"):
         gilab.experiment_plan("pm-table1")

@@ -41,7 +41,7 @@ protected:
         ctx.quick = true;
         ctx.output_dir = test::temp_dir("dag_experiments_" + name);
         ctx.assets = AssetPaths::from_environment();
-        ExperimentOutput out = run_and_write(dag_registry().get(name), ctx);
+        ExperimentOutput out = test::run_quick_checked(dag_registry().get(name), ctx);
         for (const char* file : {"results.csv", "results.json", "table.md"})
             EXPECT_TRUE(fs::exists(ctx.output_dir / file)) << name << ": " << file << " not written";
         for (const std::string& file : out.files)

@@ -28,8 +28,8 @@ ExperimentSpec cornell_spec() {
         .size = 24, .quick_size = 16,
         .frames = 2, .quick_frames = 2,
         .reference_spp = 8, .quick_reference_spp = 4,
-        .variants = {{"hash grid", "photon", {{"photon_map", "hash_grid"}}},
-                     {"kd-tree", "photon", {{"photon_map", "kd_tree"}}}},
+        .variants = {{.name = "hash grid", .technique = "photon", .settings = {{"photon_map", "hash_grid"}}},
+                     {.name = "kd-tree", .technique = "photon", .settings = {{"photon_map", "kd_tree"}}}},
         .axes = {{"photons", {4096, 8192}, {1024, 2048}}, {"radius", {0.1}, {0.1}}},
         .measures = {{"frame_ms", Source::FrameStat, "render_ms"},
                      {"photons_stored", Source::PrepareStat, "photons_stored"},
@@ -49,8 +49,8 @@ ExperimentContext context(const fs::path& dir, bool quick = true) {
 TEST(SpecRunner, ThePlanIsEveryCombinationWithTheAxesApplied) {
     const std::vector<SpecTask> quick = plan_tasks(cornell_spec(), true);
     ASSERT_EQ(quick.size(), 4u);  // 2 photon counts × 1 radius × 2 variants
-    EXPECT_EQ(quick[0].settings, (json{{"photon_map", "hash_grid"}, {"photons", 1024}, {"radius", 0.1}}));
-    EXPECT_EQ(quick[1].variant, "kd-tree");
+    EXPECT_EQ(quick[0].variants.at(0).settings, (json{{"photon_map", "hash_grid"}, {"photons", 1024}, {"radius", 0.1}}));
+    EXPECT_EQ(quick[1].variants.at(0).name, "kd-tree");
     EXPECT_EQ(quick[3].axes, (json{{"photons", 2048}, {"radius", 0.1}}));
     for (size_t i = 0; i < quick.size(); ++i) EXPECT_EQ(quick[i].id, int(i));
     EXPECT_EQ(plan_tasks(cornell_spec(), false)[2].axes.at("photons"), 8192);
@@ -160,8 +160,8 @@ TEST(SpecRunner, TheCommandPlansDeclaredExperimentsOnly) {
     for (std::string line; std::getline(lines, line); ++count) {
         const json task = json::parse(line);
         EXPECT_EQ(task.at("id"), count);
-        EXPECT_EQ(task.at("technique"), "photon");
-        EXPECT_TRUE(task.at("settings").contains("radius"));
+        EXPECT_EQ(task.at("variants").at(0).at("technique"), "photon");
+        EXPECT_TRUE(task.at("variants").at(0).at("settings").contains("radius"));
     }
     EXPECT_EQ(count, 4);
     plan.arguments = {"pm-table1"};
