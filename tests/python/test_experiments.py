@@ -47,5 +47,5 @@ def test_experiment_plan_matches_the_cli(run_cli):
     assert plan == printed
     assert [t["id"] for t in plan] == list(range(len(plan)))
     assert {v["technique"] for t in plan for v in t["variants"]} == {"photon"}
-    with pytest.raises(gilab.Error, match="not declared as a spec"):
-        gilab.experiment_plan("pm-table1")
+    with pytest.raises(gilab.Error, match="pm-radius-sweep"):
+        gilab.experiment_plan("pm-table99")

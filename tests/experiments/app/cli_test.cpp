@@ -96,7 +96,7 @@ TEST(Cli, DeclaredExperimentsRunTaskByTaskAndMerge) {
          std::vector<std::pair<std::string, std::string>>{{"experiment run-task pm-radius-sweep 4" + results, "no task 4"},
                                                           {"experiment run-task pm-radius-sweep x" + results, "not a task id"},
                                                           {"experiment run-task pm-radius-sweep" + results, "needs an experiment name and a task id"},
-                                                          {"experiment plan pm-table1", "not declared as a spec"},
+                                                          {"experiment plan pm-table99", "pm-radius-sweep"},
                                                           {"experiment merge pm-radius-sweep --results " + (dir / "none").string(), "no such directory"}}) {
         const Result r = run(args);
         EXPECT_NE(r.exit_code, 0) << args;
