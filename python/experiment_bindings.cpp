@@ -72,6 +72,17 @@ py::dict output_to_python(const Experiment& experiment, const ExperimentOutput& 
                     "directory"_a = directory ? py::cast(directory->string()) : py::none());
 }
 
+// A registered experiment by name, or one declared here as a dict (the spec's JSON form,
+// as results.json's "config" shows it); its probes and reducers are the registered ones.
+Experiment experiment_from(const py::object& name_or_spec) {
+    if (py::isinstance<py::str>(name_or_spec))
+        return ExperimentRegistry::builtin().get(name_or_spec.cast<std::string>());  // lists the names when unknown
+    if (!py::isinstance<py::dict>(name_or_spec))
+        throw Error("experiment", "expected a name or a spec dict, not " + py::str(py::type::of(name_or_spec)).cast<std::string>());
+    (void)ExperimentRegistry::builtin();  // registers the probes and reducers a spec may name
+    return declared_experiment(ExperimentSpec::from_json(python_to_json(name_or_spec, "experiment spec")));
+}
+
 }  // namespace
 
 void register_experiment_bindings(py::module_& m) {
@@ -87,23 +98,26 @@ void register_experiment_bindings(py::module_& m) {
 
     m.def(
         "experiment_plan",
-        [](const std::string& name, bool quick) {
-            const Experiment& experiment = declared_experiment_named(name);
+        [](const py::object& name_or_spec, bool quick) {
+            const Experiment experiment = py::isinstance<py::str>(name_or_spec)
+                                              ? declared_experiment_named(name_or_spec.cast<std::string>())
+                                              : experiment_from(name_or_spec);
             py::list tasks;
             for (const SpecTask& t : plan_tasks(*experiment.spec, quick)) tasks.append(json_to_python(t.to_json()));
             return tasks;
         },
-        "name"_a, "quick"_a = true,
-        "The tasks of a declared experiment as dicts (id, scene, variant, technique, axes, settings), as `gilab "
-        "experiment plan NAME --quick` (quick=False: the full plan, as without --quick).");
+        "experiment"_a, "quick"_a = true,
+        "The tasks of a declared experiment — a name, or a spec dict as run_experiment takes — as dicts (id, scene, "
+        "axes, variants with their technique or probe and settings), as `gilab experiment plan NAME --quick` "
+        "(quick=False: the full plan, as without --quick).");
 
     m.def(
         "run_experiment",
-        [](const std::string& name, bool quick, const std::optional<fs::path>& results, uint64_t seed, int threads,
-           bool verbose, const py::object& assets) {
+        [](const py::object& name_or_spec, bool quick, const std::optional<fs::path>& results, uint64_t seed,
+           int threads, bool verbose, const py::object& assets) {
             if (threads < 0 || threads > 1024)
                 throw Error("threads", std::to_string(threads) + " is not a thread count (0 = all cores, or 1 to 1024)");
-            const Experiment& experiment = ExperimentRegistry::builtin().get(name);  // lists the names when unknown
+            const Experiment experiment = experiment_from(name_or_spec);
             ExperimentContext context;
             context.quick = quick;
             context.seed = seed;
@@ -125,9 +139,25 @@ void register_experiment_bindings(py::module_& m) {
             return output_to_python(experiment, output,
                                     results ? std::optional(*results / experiment.name) : std::nullopt);
         },
-        "name"_a, "quick"_a = true, "results"_a = py::none(), "seed"_a = 1, "threads"_a = 0, "verbose"_a = false,
-        "assets"_a = py::none(), R"doc(Runs one experiment (see gilab.experiments()) as ``gilab experiment NAME`` does
-and returns its result as a dict:
+        "experiment"_a, "quick"_a = true, "results"_a = py::none(), "seed"_a = 1, "threads"_a = 0, "verbose"_a = false,
+        "assets"_a = py::none(), R"doc(Runs one experiment as ``gilab experiment NAME`` does and returns its result
+as a dict. The experiment is a name (see gilab.experiments()) or a spec declared here
+as a dict, in the form results.json's "config" shows, for example
+
+    gilab.run_experiment({
+        "name": "my-radius-sweep", "scenes": ["cornell"],
+        "size": {"full": 256, "quick": 32}, "frames": 1,
+        "variants": [{"name": "hash grid", "technique": "photon",
+                      "settings": {"photon_map": "hash_grid"}}],
+        "axes": [{"setting": "radius", "values": [0.05, 0.1]}],
+        "measures": [{"column": "frame_ms", "key": "render_ms"},
+                     {"column": "photons_stored", "key": "photons_stored",
+                      "source": "prepare stat"}]})
+
+(sources: "frame stat (median over frames)", "prepare stat", "last frame's stat",
+"relMSE against the path-traced reference", "last frame's layer mean", "last frame's
+layer digest"; a variant may name a registered "probe" instead of a technique, and the
+spec a registered "reducer"). The result:
 
     {"name", "paper", "tables": [{"title", "columns", "rows": [dict, …]}, …],
      "config", "notes", "files", "directory"}

@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 #include "core/util/error.hpp"
 #include "experiments/runner/experiment.hpp"
+#include "experiments/runner/spec_functions.hpp"
 #include "experiments/runner/spec_runner.hpp"
+#include "scenes/builtin_scenes.hpp"
 #include "experiments/runner/task_command.hpp"
 #include "tests/test_support.hpp"
 
@@ -100,6 +102,80 @@ TEST(SpecRunner, TasksRunSeparatelyMergeIntoTheTablesOfTheWholeRun) {
     EXPECT_EQ(a.rows[0].at("photons_stored"), a.rows[1].at("photons_stored"));
     EXPECT_EQ(whole.config.at("name"), "test-sweep");
     EXPECT_EQ(whole.config.at("effective").at("tasks"), 4);
+}
+
+TEST(SpecRunner, ASpecReadsBackFromItsJson) {
+    ExperimentSpec spec = cornell_spec();
+    spec.interleave_variants = true;
+    spec.slow = {.frame_ms = 100, .frames = 1};
+    spec.axes.push_back({"", {json{{"k", 16}, {"gather", "knn"}}}, {json{{"k", 8}, {"gather", "knn"}}}});
+    const ExperimentSpec back = ExperimentSpec::from_json(spec.to_json());
+    EXPECT_EQ(back.to_json(), spec.to_json());
+    EXPECT_EQ(plan_tasks(back, true).size(), plan_tasks(spec, true).size());
+    json bad = spec.to_json();
+    bad["measures"][0]["source"] = "frame stat (mean)";
+    EXPECT_NE(test::error_of([&] { ExperimentSpec::from_json(bad); }).find("unknown measure source"), std::string::npos);
+}
+
+// A probe measures what is not a technique run; a reducer lays out the table. Both are
+// called by name, and the probe's shared setup is built once per run.
+TEST(SpecRunner, ProbesAndReducersRunByName) {
+    static int loads = 0;
+    add_probe("test-meshes", [](const ProbeCall& call) {
+        const size_t meshes = call.cache.get<size_t>("triangles", [&] {
+            ++loads;
+            return call.scene().meshes.size();
+        });
+        return ProbeOutput{{json{{"meshes × factor", double(meshes) * call.setting<double>("factor")}}},
+                           {"counted " + call.task.scene},
+                           {}};
+    });
+    add_reducer("test-total", [](const SpecReduction& r) {
+        ExperimentOutput out;
+        ResultTable t{"total", {"total"}, {}};
+        double total = 0;
+        for (const TaskResult& task : r.tasks) total += task.row("count")->at("meshes × factor").get<double>();
+        t.rows.push_back({{"total", total}});
+        out.tables = {r.default_table(), t};
+        return out;
+    });
+    const ExperimentSpec spec{.name = "test-probe",
+                              .scenes = {"cornell"},
+                              .variants = {{.name = "count", .probe = "test-meshes"}},
+                              .axes = {{"factor", {1.0, 2.0, 3.0}, {1.0, 2.0}}},
+                              .reducer = "test-total"};
+    const fs::path dir = test::temp_dir("spec_probe");
+    const ExperimentOutput out = run_spec(spec, context(dir));
+    EXPECT_EQ(loads, 1);  // one run, one cache
+    const double meshes = double(make_cornell_box().meshes.size());
+    ASSERT_EQ(out.tables.size(), 2u);
+    EXPECT_EQ(out.tables[0].columns, (std::vector<std::string>{"scene", "factor", "variant", "meshes × factor"}));
+    EXPECT_EQ(out.tables[0].rows.at(1).at("meshes × factor").get<double>(), 2 * meshes);
+    EXPECT_EQ(out.tables[1].rows.at(0).at("total").get<double>(), 3 * meshes);
+    EXPECT_NE(std::find(out.notes.begin(), out.notes.end(), "counted cornell"), out.notes.end());
+    // A task run on its own builds what it needs itself.
+    run_spec_task(spec, 1, context(dir));
+    EXPECT_EQ(loads, 2);
+    ExperimentSpec unknown = spec;
+    unknown.variants[0].probe = "no-such-probe";
+    EXPECT_NE(test::error_of([&] { unknown.check(); }).find("no probe named 'no-such-probe'"), std::string::npos);
+}
+
+// Interleaved variants share a task: one task per point, a row per variant.
+TEST(SpecRunner, InterleavedVariantsShareATask) {
+    ExperimentSpec spec = cornell_spec();
+    spec.interleave_variants = true;
+    spec.measures.push_back({"digest", SpecMeasure::Source::ImageDigest, "color"});
+    const std::vector<SpecTask> tasks = plan_tasks(spec, true);
+    ASSERT_EQ(tasks.size(), 2u);
+    EXPECT_EQ(tasks[0].variants.size(), 2u);
+    const ExperimentOutput out = run_spec(spec, context(test::temp_dir("spec_interleaved")));
+    const ResultTable& t = out.tables.at(0);
+    ASSERT_EQ(t.rows.size(), 4u);
+    EXPECT_EQ(t.rows[0].at("variant"), "hash grid");
+    EXPECT_EQ(t.rows[1].at("variant"), "kd-tree");
+    EXPECT_EQ(t.rows[0].at("digest").get<std::string>().size(), 16u);
+    EXPECT_NE(t.rows[0].at("digest"), t.rows[2].at("digest"));  // more photons, another image
 }
 
 size_t merged_rows(const ExperimentSpec& spec, const fs::path& dir, bool quick) {
