@@ -160,6 +160,7 @@ std::vector<nlohmann::json> run_technique_variants(const ExperimentSpec& spec, c
 nlohmann::json run_planned_task(const ExperimentSpec& spec, const SpecTask& task, TaskCache& cache,
                                 const ExperimentContext& ctx) {
     fs::create_directories(ctx.output_dir);  // the reference cache and tasks/ live there
+    Stopwatch watch;
     std::string names;
     for (const TaskVariant& v : task.variants) names += (names.empty() ? "" : ", ") + v.name;
     ctx.say("task " + std::to_string(task.id) + ": " + task.scene + ", " + names + ", " + task.axes.dump());
@@ -188,6 +189,7 @@ nlohmann::json run_planned_task(const ExperimentSpec& spec, const SpecTask& task
         for (std::string& file : out.files) files.push_back(std::move(file));
     }
     result["rows"] = rows;
+    result["seconds"] = watch.elapsed_ms() / 1000.0;
     result["notes"] = notes;
     result["files"] = files;
     result["per_frame"] = per_frame;
@@ -340,6 +342,21 @@ ExperimentOutput merge_spec_tasks(const ExperimentSpec& spec, const ExperimentCo
         out.notes.push_back("Tasks ran at more than one revision, thread count or machine: times are comparable only "
                             "within one.");
     return out;
+}
+
+std::optional<double> last_task_seconds(const ExperimentSpec& spec, const SpecTask& task, const ExperimentContext& ctx) {
+    const fs::path file = spec_task_file(ctx.output_dir, task.id, ctx.quick);
+    if (!fs::exists(file)) return std::nullopt;
+    try {
+        std::ifstream in(file);
+        const nlohmann::json result = nlohmann::json::parse(in);
+        if (!identity_mismatch(result, task_identity(spec, task, ctx.quick, ctx.seed), ctx.quick).empty() ||
+            !result.contains("seconds"))
+            return std::nullopt;
+        return result.at("seconds").get<double>();
+    } catch (const nlohmann::json::exception&) {
+        return std::nullopt;  // an unreadable file estimates nothing; merge reports it
+    }
 }
 
 ExperimentOutput run_spec(const ExperimentSpec& spec, const ExperimentContext& ctx) {

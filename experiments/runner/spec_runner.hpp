@@ -5,6 +5,7 @@
 // by one, on several machines, as a job array) and be merged afterwards. Running the
 // whole experiment is plan, every task, then merge.
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <nlohmann/json.hpp>
 #include "experiments/runner/experiment.hpp"
@@ -26,6 +27,10 @@ nlohmann::json run_spec_task(const ExperimentSpec& spec, int task_id, const Expe
 // effective.tasks_missing (such a merge is not a finished run for --resume), and no task
 // at all is an Error.
 ExperimentOutput merge_spec_tasks(const ExperimentSpec& spec, const ExperimentContext& ctx);
+
+// How long task `task` took when its result file under ctx.output_dir was written (the
+// same plan), or nothing: the plan's cost estimate.
+std::optional<double> last_task_seconds(const ExperimentSpec& spec, const SpecTask& task, const ExperimentContext& ctx);
 
 // Plan, run every task, merge: what `gilab experiment NAME` does for a declared one.
 ExperimentOutput run_spec(const ExperimentSpec& spec, const ExperimentContext& ctx);

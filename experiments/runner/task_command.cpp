@@ -39,10 +39,6 @@ int run_task_command(const TaskCommand& c, std::ostream& out) {
         throw Error(c.verb, c.verb == "run-task" ? "needs an experiment name and a task id: run-task NAME ID"
                                                  : "needs one experiment name: " + c.verb + " NAME");
     const Experiment& e = declared_experiment_named(c.arguments[0]);
-    if (c.verb == "plan") {
-        for (const SpecTask& t : plan_tasks(*e.spec, c.quick)) out << t.to_json().dump() << "\n";
-        return 0;
-    }
     ExperimentContext ctx;
     ctx.quick = c.quick;
     ctx.output_dir = c.results_root / e.name;
@@ -50,6 +46,14 @@ int run_task_command(const TaskCommand& c, std::ostream& out) {
     ctx.seed = c.seed;
     ctx.threads = c.threads;
     ctx.log = &out;
+    if (c.verb == "plan") {
+        for (const SpecTask& t : plan_tasks(*e.spec, c.quick)) {
+            nlohmann::json line = t.to_json();
+            if (const auto seconds = last_task_seconds(*e.spec, t, ctx)) line["seconds_last_run"] = *seconds;
+            out << line.dump() << "\n";
+        }
+        return 0;
+    }
     if (c.verb == "run-task") {
         const int id = task_id(c.arguments[1]);
         run_spec_task(*e.spec, id, ctx);

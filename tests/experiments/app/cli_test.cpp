@@ -84,6 +84,13 @@ TEST(Cli, DeclaredExperimentsRunTaskByTaskAndMerge) {
     if (contains(task.output, "not found")) GTEST_SKIP() << task.output;  // the conference room is a shared asset
     ASSERT_EQ(task.exit_code, 0) << task.output;
     EXPECT_TRUE(fs::exists(dir / "pm-radius-sweep" / "tasks" / "quick" / "1.json"));
+    // The plan now knows what task 1 cost.
+    const Result replan = run("experiment plan pm-radius-sweep" + results);
+    size_t estimates = 0;
+    for (size_t at = replan.output.find("seconds_last_run"); at != std::string::npos;
+         at = replan.output.find("seconds_last_run", at + 1))
+        ++estimates;
+    EXPECT_EQ(estimates, 1u) << replan.output;
     const Result merge = run("experiment merge pm-radius-sweep" + results);
     ASSERT_EQ(merge.exit_code, 0) << merge.output;
     std::ifstream table(dir / "pm-radius-sweep" / "table.md");
