@@ -94,7 +94,9 @@ nlohmann::json ExperimentSpec::to_json() const {
     for (const SpecMeasure& m : measures)
         j["measures"].push_back({{"column", m.column}, {"source", to_string(m.source)}, {"key", m.key}});
     if (!reducer.empty()) j["reducer"] = reducer;
-    if (!measures.empty()) j["statistic"] = "median over a task's frames (frame stats)";
+    if (!measures.empty())
+        j["statistic"] = statistic == FrameStatistic::Mean ? "mean over a task's frames (frame stats)"
+                                                           : "median over a task's frames (frame stats)";
     j["notes"] = notes;
     return j;
 }
@@ -152,6 +154,10 @@ ExperimentSpec ExperimentSpec::from_json(const nlohmann::json& j) {
         s.measures.push_back(std::move(measure));
     }
     s.reducer = field<std::string>(j, "reducer", "", where);
+    const std::string statistic = field<std::string>(j, "statistic", "median", where);
+    if (statistic.rfind("mean", 0) == 0) s.statistic = FrameStatistic::Mean;
+    else if (statistic.rfind("median", 0) != 0)
+        throw Error(where, "statistic '" + statistic + "' is neither 'median' nor 'mean'");
     s.notes = field<std::vector<std::string>>(j, "notes", {}, where);
     return s;
 }

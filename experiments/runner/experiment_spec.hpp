@@ -35,7 +35,7 @@ struct SpecAxis {
 };
 
 // What a technique task measures for each variant. Frame stats are the median over the
-// task's frames; last-frame stats are read after the last frame; prepare stats once
+// task's frames (or the mean: ExperimentSpec::statistic); last-frame stats are read after the last frame; prepare stats once
 // after prepare; relMSE compares the last frame's layer with the path-traced reference
 // of the same scene and camera; a layer mean is the last frame's mean of that layer; an
 // image digest is a hash of the last frame's layer (equal digests: identical images).
@@ -53,6 +53,9 @@ struct SpecSlowFrames {
     int frames = 0;
 };
 
+// How frame stats over a task's frames become one figure.
+enum class FrameStatistic { Median, Mean };
+
 struct ExperimentSpec {
     std::string name, paper, figure, description;
     // Scene names as `gilab render` takes them (technique variants), or the labels a
@@ -62,6 +65,7 @@ struct ExperimentSpec {
     int frames = 5, quick_frames = 2;  // renders per task
     int reference_spp = 1024, quick_reference_spp = 64;  // path-traced reference (RelMse measures)
     SpecSlowFrames slow;
+    FrameStatistic statistic = FrameStatistic::Median;  // of FrameStat measures
     // All variants in one task, rendered in turn frame by frame (A B C A B C …), so that
     // a change in machine load hits them alike and ratios between them are fair.
     bool interleave_variants = false;

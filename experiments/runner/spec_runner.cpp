@@ -40,6 +40,7 @@ nlohmann::json task_identity(const ExperimentSpec& spec, const SpecTask& t, bool
     for (const SpecMeasure& m : spec.measures) measures.push_back({m.column, m.key, int(m.source)});
     return {{"quick", quick},
             {"seed", seed},
+            {"statistic", int(spec.statistic)},
             {"task", t.to_json()},
             {"size", size_of(spec, quick)},
             {"frames", frames_of(spec, quick)},
@@ -55,7 +56,7 @@ std::string identity_mismatch(const nlohmann::json& result, const nlohmann::json
     if (!result.contains("seed") || result["seed"] != identity["seed"])
         return "it was written with --seed " + result.value("seed", nlohmann::json()).dump() + ", not " +
                identity["seed"].dump();
-    for (const char* key : {"task", "size", "frames", "reference_spp", "measure_list"})
+    for (const char* key : {"task", "size", "frames", "reference_spp", "measure_list", "statistic"})
         if (!result.contains(key) || result[key] != identity[key])
             return std::string("its '") + key + "' differs from this plan's (the spec changed since it ran); run the "
                                                 "task again";
@@ -135,7 +136,10 @@ std::vector<nlohmann::json> run_technique_variants(const ExperimentSpec& spec, c
         nlohmann::json row = {{"variant", variants[v]->name}};
         for (const SpecMeasure& m : spec.measures) {
             switch (m.source) {
-                case Source::FrameStat: row[m.column] = median(per_frame[v][m.key]); break;
+                case Source::FrameStat:
+                    row[m.column] = spec.statistic == FrameStatistic::Mean ? mean(per_frame[v][m.key])
+                                                                           : median(per_frame[v][m.key]);
+                    break;
                 case Source::PrepareStat: row[m.column] = prepared[v].get(m.key); break;
                 case Source::LastFrameStat: row[m.column] = last[v].get(m.key); break;
                 case Source::LayerMean: row[m.column] = mean_value(films[v], m.key); break;

@@ -108,6 +108,7 @@ TEST(SpecRunner, ASpecReadsBackFromItsJson) {
     ExperimentSpec spec = cornell_spec();
     spec.interleave_variants = true;
     spec.slow = {.frame_ms = 100, .frames = 1};
+    spec.statistic = FrameStatistic::Mean;
     spec.axes.push_back({"", {json{{"k", 16}, {"gather", "knn"}}}, {json{{"k", 8}, {"gather", "knn"}}}});
     const ExperimentSpec back = ExperimentSpec::from_json(spec.to_json());
     EXPECT_EQ(back.to_json(), spec.to_json());
