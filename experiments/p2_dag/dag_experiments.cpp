@@ -57,7 +57,12 @@ const ModelSpec& model_spec(const std::string& scene) {
     throw Error("P2 DAG experiments", "no model for scene '" + scene + "' (bunny, buddha or dragon)");
 }
 
-const std::vector<std::string> kModelScenes = {"bunny", "buddha", "dragon"};
+// The spec's scenes: the models in the paper's order.
+std::vector<std::string> model_scenes() {
+    std::vector<std::string> scenes;
+    for (const ModelSpec& m : model_specs()) scenes.push_back(m.scene);
+    return scenes;
+}
 
 // ---- The paper's published figures (experiments/papers/p2; reference data, never used as results) ----
 
@@ -737,7 +742,7 @@ Plot single_ray_plot(const std::string& label, uint32_t res, const std::vector<j
 
 ExperimentOutput reduce_fig13(const SpecReduction& r) {
     const json& point = axis_points(r).at(0);
-    const uint32_t res = point["resolution"].get<uint32_t>();
+    const uint32_t res = point.at("resolution").get<uint32_t>();
     // Fig. 13 prints no values; the text says the times are about equal.
     const std::string paper_time_ratio =
         paper_figures("p2/fig13").row({{"structures", "SVO, ESVO, SVDAG"}}).text("time ratio");
@@ -762,8 +767,8 @@ ExperimentOutput reduce_fig13(const SpecReduction& r) {
                      "paper_time_ratio"};
     ResultTable single_table;
     single_table.title = "Fig. 13: ten single primary rays (hitting rays spread over the image), each traced alone on "
-                         "one thread, median over " + point["single_ray_batches"].dump() + " batches of " +
-                         point["single_ray_repeats"].dump() + " traversals";
+                         "one thread, median over " + r.spec.variants.at(0).settings.at("single_ray_batches").dump() +
+                         " batches of " + point.at("single_ray_repeats").dump() + " traversals";
     single_table.columns = {"scene", "ray", "pixel", "nodes_visited", "svo_us", "esvo_us", "svdag_us",
                             "svdag_over_svo_time"};
     for (const TaskResult& t : r.tasks) {
@@ -804,7 +809,7 @@ void register_dag_experiments(ExperimentRegistry& registry) {
         .figure = "Table 1",
         .description = "nodes and pointers of SVO, ESVO and SVDAG (plus OpenVDB and OctoMap) for the bunny, Buddha and "
                        "dragon at 1000³ (Table 1)",
-        .scenes = kModelScenes,
+        .scenes = model_scenes(),
         .variants = {structures},
         .axes = {{"resolution", {1000}, {128}}},
         .reducer = "dag-table1",
@@ -827,7 +832,7 @@ void register_dag_experiments(ExperimentRegistry& registry) {
         .paper = "P2",
         .figure = "Table 2",
         .description = "storage of SVO, ESVO and SVDAG (plus OpenVDB and OctoMap) at 512³ and 1000³ (Table 2)",
-        .scenes = kModelScenes,
+        .scenes = model_scenes(),
         .variants = {structures},
         .axes = {{"resolution", {512, 1000}, {64, 128}}},
         .reducer = "dag-table2",
@@ -852,7 +857,7 @@ void register_dag_experiments(ExperimentRegistry& registry) {
         .figure = "Table 3",
         .description = "SVO→SVDAG conversion time t_A and identical-node search time t_B, 128³ to 8192³, with the split "
                        "build and per-row peak memory (Table 3)",
-        .scenes = kModelScenes,
+        .scenes = model_scenes(),
         .variants = {{.name = "SVO→SVDAG", .probe = "dag-conversion"}},
         .axes = {{"",
                   {row(128, "whole", 7, 256), row(256, "whole", 7, 256), row(512, "whole", 5, 256),
@@ -894,7 +899,7 @@ void register_dag_experiments(ExperimentRegistry& registry) {
         .paper = "P2",
         .figure = "Fig. 13",
         .description = "primary-ray throughput and nodes visited per ray through SVO, ESVO and SVDAG (Fig. 13)",
-        .scenes = kModelScenes,
+        .scenes = model_scenes(),
         .size = 512, .quick_size = 128,
         .variants = {{.name = "SVO, ESVO, SVDAG",
                       .probe = "dag-traversal",
