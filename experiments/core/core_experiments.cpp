@@ -6,11 +6,15 @@
 #include "core/render/ray_tracer.hpp"
 #include "core/util/stats.hpp"
 #include "experiments/runner/experiment.hpp"
+#include "experiments/runner/measures.hpp"
+#include "experiments/runner/spec_functions.hpp"
 #include "scenes/scene_library.hpp"
 
 namespace gilab {
 
 namespace {
+
+using nlohmann::json;
 
 EyeCamera camera_for(const Scene& scene, int width, int height) {
     SceneCamera c = scene.camera.value_or(default_camera_for(scene.evaluate(0).bounds));
@@ -44,16 +48,6 @@ ShadowTarget shadow_target(const Scene& scene, const SceneFrame& frame) {
     return target;
 }
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-}
-
-struct Throughput {
-    double single_mrays = 0, stream_mrays = 0;
-    size_t rays = 0;
-};
-
 // Times `trace_tile` over every tile, `repeats` times, and returns the median Mrays/s.
 template <typename TraceTile>
 double measure(const std::vector<Tile>& tiles, size_t rays, int repeats, TraceTile trace_tile) {
@@ -68,116 +62,153 @@ double measure(const std::vector<Tile>& tiles, size_t rays, int repeats, TraceTi
     return median(rates);
 }
 
-ExperimentOutput run_core_rays(const ExperimentContext& ctx) {
-    const int size = ctx.quick ? 256 : 1024;
-    const int repeats = ctx.quick ? 3 : 7;
-    const int tile = 16;
-    ResultTable table;
-    table.title = "Embree ray throughput, " + std::to_string(size) + "² primary rays from the scene camera";
-    table.columns = {"scene", "triangles", "bvh_build_ms", "ray_kind", "rays", "single_mrays_per_s",
-                     "stream_mrays_per_s", "stream_over_single", "hit_fraction"};
-    ExperimentOutput out;
-    std::vector<std::string> scenes = {"cornell", "bunny", "sponza"};
-    out.config = {{"resolution", size}, {"repeats", repeats}, {"tile", tile}, {"scenes", scenes},
-                  {"statistic", "median over repeats"}};
-
+std::vector<Tile> image_tiles(int size, int tile) {
     std::vector<Tile> tiles;
     for (int y = 0; y < size; y += tile)
         for (int x = 0; x < size; x += tile) tiles.push_back({x, y, std::min(x + tile, size), std::min(y + tile, size)});
+    return tiles;
+}
 
-    for (const std::string& name : scenes) {
-        Scene scene;
-        try {
-            scene = open_scene(name, ctx.assets).scene;
-        } catch (const Error& e) {
-            out.notes.push_back("scene '" + name + "' skipped: " + std::string(e.what()));
-            ctx.say("skipping " + name + ": " + e.what());
-            continue;
-        }
-        ctx.say("scene " + name + ": " + std::to_string(scene.triangle_count()) + " triangles");
-        SceneFrame frame = scene.evaluate(0);
-        Stopwatch build;
-        RayTracer tracer(frame);
-        double build_ms = build.elapsed_ms();
-        EyeCamera camera = camera_for(scene, size, size);
-        ShadowTarget target = shadow_target(scene, frame);
-        float scale = std::max(1e-4f, 1e-5f * glm::length(frame.bounds.extent()));
+// Primary rays through every pixel centre, and for each hit one shadow ray towards the
+// light (a ray that left the scene still casts a trivial one, so both sets are as large).
+struct RaySets {
+    std::vector<Ray> primary, shadow;
+    size_t hits = 0;
+};
 
-        // Primary rays, and for each hit one shadow ray towards the light.
-        const size_t n = size_t(size) * size_t(size);
-        std::vector<Ray> primary(n), shadow(n);
-        for (int y = 0; y < size; ++y)
-            for (int x = 0; x < size; ++x) primary[size_t(y) * size + x] = camera.generate_ray(x + 0.5f, y + 0.5f);
-        std::vector<Hit> hits(n);
-        tracer.intersect(primary, hits);
-        size_t hit_count = 0;
-        for (size_t i = 0; i < n; ++i) {
-            Ray s;
-            if (!hits[i].valid()) {  // a ray that left the scene still casts a (trivial) shadow ray
-                s.origin = primary[i].origin;
-                s.direction = Vec3(0, 1, 0);
-                s.tmax = 0.0f;
+RaySets trace_setup(const Scene& scene, const SceneFrame& frame, const RayTracer& tracer, int size) {
+    const EyeCamera camera = camera_for(scene, size, size);
+    const ShadowTarget target = shadow_target(scene, frame);
+    const float scale = std::max(1e-4f, 1e-5f * glm::length(frame.bounds.extent()));
+    const size_t n = size_t(size) * size_t(size);
+    RaySets sets;
+    sets.primary.resize(n);
+    sets.shadow.resize(n);
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) sets.primary[size_t(y) * size + x] = camera.generate_ray(x + 0.5f, y + 0.5f);
+    std::vector<Hit> hits(n);
+    tracer.intersect(sets.primary, hits);
+    for (size_t i = 0; i < n; ++i) {
+        Ray s;
+        if (!hits[i].valid()) {
+            s.origin = sets.primary[i].origin;
+            s.direction = Vec3(0, 1, 0);
+            s.tmax = 0.0f;
+        } else {
+            ++sets.hits;
+            Vec3 p = sets.primary[i].at(hits[i].t) - scale * sets.primary[i].direction;
+            s.origin = p;
+            if (target.directional) {
+                s.direction = target.point_or_direction;
             } else {
-                ++hit_count;
-                Vec3 p = primary[i].at(hits[i].t) - scale * primary[i].direction;
-                s.origin = p;
-                if (target.directional) {
-                    s.direction = target.point_or_direction;
-                } else {
-                    s.direction = target.point_or_direction - p;
-                    s.tmax = 1.0f - 1e-3f;
-                }
+                s.direction = target.point_or_direction - p;
+                s.tmax = 1.0f - 1e-3f;
             }
-            shadow[i] = s;
         }
-
-        auto tile_indices = [&](const Tile& t, auto&& fn) {
-            for (int y = t.y0; y < t.y1; ++y)
-                for (int x = t.x0; x < t.x1; ++x) fn(size_t(y) * size + x);
-        };
-        for (int kind = 0; kind < 2; ++kind) {
-            const std::vector<Ray>& rays = kind == 0 ? primary : shadow;
-            double single = measure(tiles, n, repeats, [&](const Tile& t) {
-                tile_indices(t, [&](size_t i) {
-                    if (kind == 0) (void)tracer.intersect(rays[i]);
-                    else (void)tracer.occluded(rays[i]);
-                });
-            });
-            double stream = measure(tiles, n, repeats, [&](const Tile& t) {
-                std::vector<Ray> batch;
-                batch.reserve(size_t(tile * tile));
-                tile_indices(t, [&](size_t i) { batch.push_back(rays[i]); });
-                if (kind == 0) {
-                    std::vector<Hit> h(batch.size());
-                    tracer.intersect(batch, h);
-                } else {
-                    std::vector<uint8_t> b(batch.size());
-                    tracer.occluded(batch, b);
-                }
-            });
-            table.rows.push_back({{"scene", name},
-                                  {"triangles", scene.triangle_count()},
-                                  {"bvh_build_ms", build_ms},
-                                  {"ray_kind", kind == 0 ? "primary (closest hit)" : "shadow (occlusion)"},
-                                  {"rays", n},
-                                  {"single_mrays_per_s", single},
-                                  {"stream_mrays_per_s", stream},
-                                  {"stream_over_single", stream / single},
-                                  {"hit_fraction", double(hit_count) / double(n)}});
-        }
+        sets.shadow[i] = s;
     }
+    return sets;
+}
+
+// core-rays, one scene: the primary and the shadow rays, each traced one call per ray and
+// one stream call per tile, every pass timed `frames` times.
+ProbeOutput ray_throughput(const ProbeCall& call) {
+    ProbeOutput out;
+    const Scene* loaded = nullptr;
+    try {
+        loaded = &call.scene();
+    } catch (const Error& e) {
+        out.notes.push_back("scene '" + call.task.scene + "' skipped: " + std::string(e.what()));
+        call.ctx.say("skipping " + call.task.scene + ": " + e.what());
+        return out;
+    }
+    const Scene& scene = *loaded;
+    const int size = call.size, repeats = call.frames, tile = call.setting<int>("tile");
+    call.ctx.say("scene " + call.task.scene + ": " + std::to_string(scene.triangle_count()) + " triangles");
+    const SceneFrame frame = scene.evaluate(0);
+    Stopwatch build;
+    const RayTracer tracer(frame);
+    const double build_ms = build.elapsed_ms();
+    const RaySets sets = trace_setup(scene, frame, tracer, size);
+    const std::vector<Tile> tiles = image_tiles(size, tile);
+    const size_t n = sets.primary.size();
+
+    auto tile_indices = [&](const Tile& t, auto&& fn) {
+        for (int y = t.y0; y < t.y1; ++y)
+            for (int x = t.x0; x < t.x1; ++x) fn(size_t(y) * size + x);
+    };
+    for (int kind = 0; kind < 2; ++kind) {
+        const std::vector<Ray>& rays = kind == 0 ? sets.primary : sets.shadow;
+        const double single = measure(tiles, n, repeats, [&](const Tile& t) {
+            tile_indices(t, [&](size_t i) {
+                if (kind == 0) (void)tracer.intersect(rays[i]);
+                else (void)tracer.occluded(rays[i]);
+            });
+        });
+        const double stream = measure(tiles, n, repeats, [&](const Tile& t) {
+            std::vector<Ray> batch;
+            batch.reserve(size_t(tile * tile));
+            tile_indices(t, [&](size_t i) { batch.push_back(rays[i]); });
+            if (kind == 0) {
+                std::vector<Hit> h(batch.size());
+                tracer.intersect(batch, h);
+            } else {
+                std::vector<uint8_t> b(batch.size());
+                tracer.occluded(batch, b);
+            }
+        });
+        out.rows.push_back({{"triangles", scene.triangle_count()},
+                            {"bvh_build_ms", build_ms},
+                            {"ray_kind", kind == 0 ? "primary (closest hit)" : "shadow (occlusion)"},
+                            {"rays", n},
+                            {"single_mrays_per_s", single},
+                            {"stream_mrays_per_s", stream},
+                            {"stream_over_single", stream / single},
+                            {"hit_fraction", double(sets.hits) / double(n)}});
+    }
+    return out;
+}
+
+// The scenes' rows in one table titled with this run's image size.
+ExperimentOutput ray_throughput_table(const SpecReduction& r) {
+    ResultTable table;
+    table.title = "Embree ray throughput, " + std::to_string(r.size()) + "² primary rays from the scene camera";
+    table.columns = {"scene", "triangles", "bvh_build_ms", "ray_kind", "rays", "single_mrays_per_s",
+                     "stream_mrays_per_s", "stream_over_single", "hit_fraction"};
+    for (const TaskResult& t : r.tasks)
+        for (const json& measured : t.rows) {
+            json row = {{"scene", t.task.scene}};
+            for (const std::string& c : table.columns)
+                if (measured.contains(c)) row[c] = measured[c];
+            table.rows.push_back(std::move(row));
+        }
     if (table.rows.empty()) throw Error("core-rays", "no scene could be loaded");
+    ExperimentOutput out;
     out.tables.push_back(std::move(table));
-    out.notes.push_back("single = one rtcIntersect1/rtcOccluded1 call per ray; stream = one rtcIntersect1M/rtcOccluded1M "
-                        "call per 16×16 tile (coherent flag). Both use all threads, same tiles.");
     return out;
 }
 
 }  // namespace
 
 void register_core_experiments(ExperimentRegistry& registry) {
-    registry.add({"core-rays", "core", "primary and shadow ray throughput, single rays vs streams (Embree 3)",
-                  run_core_rays});
+    add_probe("core-rays", ray_throughput);
+    add_reducer("core-rays", ray_throughput_table);
+    registry.add(declared_experiment({
+        .name = "core-rays",
+        .paper = "core",
+        .figure = "Ray throughput",
+        .description = "primary and shadow ray throughput, single rays vs streams (Embree 3)",
+        .scenes = {"cornell", "bunny", "sponza"},
+        .size = 1024, .quick_size = 256,  // primary rays: one per pixel of a square image
+        .frames = 7, .quick_frames = 3,   // timed passes over all rays; the median counts
+        .variants = {{.name = "embree", .probe = "core-rays", .settings = {{"tile", 16}}}},
+        .reducer = "core-rays",
+        .notes = {"single = one rtcIntersect1/rtcOccluded1 call per ray; stream = one rtcIntersect1M/rtcOccluded1M "
+                  "call per 16×16 tile (coherent flag). Both use all threads, same tiles.",
+                  "Mrays/s = the median over the repeated passes (the spec's frames) of all rays of one kind; shadow "
+                  "rays go from each primary hit towards the first punctual light (else the emitters' centroid), a "
+                  "miss casts a trivial one."},
+    }));
 }
 
 }  // namespace gilab

@@ -170,3 +170,33 @@ TEST(DynamicDagExperiments, Table6FrameRates) {
                                       [](const std::string& f) { return f.starts_with("frame_"); });
     EXPECT_EQ(size_t(images), t.rows.size() / 3);  // one frame image per scene
 }
+
+// The plans: Table 5 measures each scene at 512³ and (full runs) the Kämpe 2016 block at
+// the grid and frame count of its published figure; Table 6 one task per scene and image.
+TEST(DynamicDagExperiments, PlansOneTaskPerSceneAndPoint) {
+    const Experiment& table5 = dynamic_registry().get("dag-table5");
+    ASSERT_TRUE(table5.spec);
+    const std::vector<SpecTask> full = plan_tasks(*table5.spec, false);
+    ASSERT_EQ(full.size(), 6u);
+    const std::vector<std::string> scenes = {"kitchen", "robot", "fire"};
+    for (size_t s = 0; s < scenes.size(); ++s) {
+        const SpecTask& main = full[2 * s];
+        const SpecTask& kampe = full[2 * s + 1];
+        EXPECT_EQ(main.scene, scenes[s]);
+        EXPECT_EQ(kampe.scene, scenes[s]);
+        EXPECT_EQ(main.axes, json({{"resolution", 512}, {"all_at_once", true}}));
+        EXPECT_EQ(kampe.axes,
+                  json({{"resolution", 2048}, {"frames", 70}, {"all_at_once", false}, {"memory_estimate_from", 512}}));
+    }
+    EXPECT_EQ(plan_tasks(*table5.spec, true).size(), 3u);
+
+    const Experiment& table6 = dynamic_registry().get("dag-table6");
+    ASSERT_TRUE(table6.spec);
+    const std::vector<SpecTask> quick = plan_tasks(*table6.spec, true);
+    ASSERT_EQ(quick.size(), 9u);
+    EXPECT_EQ(quick[0].axes, json({{"resolution", 64}, {"width", 160}, {"height", 120}, {"paper_size", "1024×768"}}));
+    const std::vector<SpecTask> full6 = plan_tasks(*table6.spec, false);
+    ASSERT_EQ(full6.size(), 9u);
+    EXPECT_EQ(full6[8].axes, json({{"resolution", 512}, {"width", 400}, {"height", 300}, {"paper_size", "400×300"}}));
+    EXPECT_EQ(full6[8].scene, "fire");
+}

@@ -165,6 +165,10 @@ void add_p2(std::map<std::string, Expected>& e) {
             for (int i = 0; i < 3; ++i) t.rows.push_back({scene, images[i], fps[i]});
         e["p2/table6"] = t;
     }
+    // Kämpe et al. 2016, cited beside Table 5: one sequence, its grid, frames and size.
+    e["p2/table5_kampe2016"] = {{"sequence", "resolution (voxels/axis)", "frames", "MB"},
+                                {"sequence"},
+                                {{"captured performer", 2048.0, 70.0, 1.86}}};
     e["p2/fig13"] = {{"structures", "time ratio"}, {"structures"}, {{"SVO, ESVO, SVDAG", "≈ 1 (about equal)"}}};
     e["p2/fig16_18"] = {{"scene", "structure", "mean vs shadow map (%)"},
                         {"scene", "structure"},
