@@ -9,7 +9,6 @@
 // to the results).
 #include <algorithm>
 #include <cmath>
-#include <optional>
 #include "core/image/image_io.hpp"
 #include "core/image/image_metrics.hpp"
 #include "core/util/settings.hpp"
@@ -21,6 +20,7 @@
 #include "experiments/runner/spec_functions.hpp"
 #include "core/scene/scene.hpp"
 #include "core/util/error.hpp"
+#include "core/util/format.hpp"
 #include "techniques/technique.hpp"
 
 namespace gilab {
@@ -388,9 +388,10 @@ ProbeOutput fig8_probe(const ProbeCall& call) {
 
 ExperimentOutput reduce_fig8(const SpecReduction& r) {
     ResultTable t;
-    const int photons = r.ctx.quick ? 256 : 512;
-    t.title = "Fig. 8 — heap of " + std::to_string(kHeapSize) + " vs no heap, " + squared(photons) +
-              " photons, r = 0.08 (images written beside this table)";
+    const json point = r.tasks.empty() ? json::object() : r.tasks.front().task.axes;
+    t.title = "Fig. 8 — heap of " + std::to_string(kHeapSize) + " vs no heap, " +
+              squared(int(std::lround(std::sqrt(point.value("photons", 0.0))))) +
+              " photons, r = " + format_number(point.value("radius", 0.0)) + " (images written beside this table)";
     t.columns = {"variant", "image", "frame_ms", "mean_color", "mean_indirect", "indirect vs reference",
                  "relmse_indirect", "relmse_color"};
     for (const TaskResult& task : r.tasks)
@@ -424,7 +425,7 @@ void register_photon_experiments(ExperimentRegistry& registry) {
     registry.add(declared_experiment(ab_spec(
         {.name = "pm-table1",
          .figure = "Table 1",
-         .description = "Table 1: photon-map structures (kd-tree, hash grid, nanoflann), kNN heap gather, Cornell box",
+         .description = "photon-map structures (kd-tree, hash grid, nanoflann), kNN heap gather, Cornell box",
          .variants = {photon("kd_tree", knn_on("kd_tree")), photon("hash_grid", knn_on("hash_grid")),
                       photon("nanoflann", knn_on("nanoflann"))},
          .notes = {"Paper shape: the hash grid wins at small r and loses at large r with many photons (hash/kd < 1 at "
@@ -436,7 +437,7 @@ void register_photon_experiments(ExperimentRegistry& registry) {
     registry.add(declared_experiment(ab_spec(
         {.name = "pm-table2",
          .figure = "Table 2",
-         .description = "Table 2: hash-grid gather with a kNN heap vs without (all photons within r)",
+         .description = "hash-grid gather with a kNN heap vs without (all photons within r)",
          .variants = {photon("heap", knn_on("hash_grid")),
                       photon("no heap", {{"photon_map", "hash_grid"}, {"gather", "radius"}, {"pass", "fused"}})},
          .notes = {"Paper shape: dropping the heap is far faster at large r (8–32× on the GPU, where the heap lives in "
@@ -451,7 +452,7 @@ void register_photon_experiments(ExperimentRegistry& registry) {
     registry.add(declared_experiment(ab_spec(
         {.name = "pm-table3",
          .figure = "Table 3",
-         .description = "Table 3: fused vs split trace/gather passes (the paper's single vs hybrid kernel)",
+         .description = "fused vs split trace/gather passes (the paper's single vs hybrid kernel)",
          .variants = {photon("fused", with(radius_gather, {{"pass", "fused"}})),
                       photon("split", with(radius_gather, {{"pass", "split"}}))},
          .notes = {"The paper's single vs hybrid kernel (one OptiX kernel vs OptiX trace + CUDA gather) maps to our "
@@ -470,7 +471,7 @@ void register_photon_experiments(ExperimentRegistry& registry) {
     registry.add(declared_experiment(ab_spec(
         {.name = "pm-table4",
          .figure = "Table 4",
-         .description = "Table 4: per-hit vs tile-shared gather (the paper's Algorithm 1, shared memory) vs cell groups",
+         .description = "per-hit vs tile-shared gather (the paper's Algorithm 1, shared memory) vs cell groups",
          .variants = {photon("off", mode("off", "cell")), photon("paper", mode("paper", "tiles")),
                       photon("cell_groups", mode("cell_groups", "cell")),
                       photon("off, tile order", mode("off", "tiles"))},
@@ -497,7 +498,7 @@ void register_photon_experiments(ExperimentRegistry& registry) {
         .name = "pm-fig8",
         .paper = "P1",
         .figure = "Fig. 8",
-        .description = "Fig. 8: images with a heap of 128 vs without heap, 512² photons, r = 0.08",
+        .description = "images with a heap of 128 vs without heap, 512² photons, r = 0.08",
         .scenes = {"cornell"},
         .size = 512, .quick_size = 128,
         .frames = 5, .quick_frames = 5,

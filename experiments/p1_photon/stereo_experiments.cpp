@@ -416,7 +416,7 @@ void register_stereo_experiments(ExperimentRegistry& registry) {
         .name = "pm-table5",
         .paper = "P1",
         .figure = "Table 5",
-        .description = "Table 5: both eyes, eyes separately vs stereo reuse (nearest and strict), Cornell and Office; "
+        .description = "both eyes, eyes separately vs stereo reuse (nearest and strict), Cornell and Office; "
                        "reuse vs IPD and distance",
         .scenes = scenes,
         .frames = 5, .quick_frames = 2,
@@ -451,7 +451,7 @@ void register_stereo_experiments(ExperimentRegistry& registry) {
         .name = "pm-final",
         .paper = "P1",
         .figure = "Figs. 9–11",
-        .description = "Figs. 9–11: final stereo renders with global/direct/indirect layers vs path tracing",
+        .description = "final stereo renders with global/direct/indirect layers vs path tracing",
         .scenes = scenes,
         .frames = 5, .quick_frames = 2,
         .reference_spp = 256, .quick_reference_spp = 64,
@@ -475,7 +475,7 @@ void register_stereo_experiments(ExperimentRegistry& registry) {
         .name = "pm-foveated",
         .paper = "P1",
         .figure = "Foveated gather",
-        .description = "Foveated gather (the paper's future work): time vs error in and out of the fovea",
+        .description = "the paper's future work: time vs error in and out of the fovea",
         .scenes = scenes,
         .frames = 5, .quick_frames = 2,
         .reference_spp = 256, .quick_reference_spp = 64,
