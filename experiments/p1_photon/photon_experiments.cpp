@@ -137,7 +137,8 @@ std::vector<std::string> run_notes(const SpecReduction& r) {
     std::vector<std::string> notes = {
         "frame_ms = one render(): primary rays and the photon gather (no shadow rays), at " + size + "×" + size +
             "; median over " + std::to_string(r.frames()) +
-            " frames (3 when a frame takes over 2 s), the variants of a row rendered in turn frame by frame so that "
+            " frames (" + std::to_string(r.spec.slow.frames) + " when a frame takes over " +
+            std::to_string(int(r.spec.slow.frame_ms / 1000)) + " s), the variants of a row rendered in turn frame by frame so that "
             "load changes hit them alike. Photon tracing (photon_trace_ms) and building the map (build_ms) happen "
             "once in prepare() and are reported separately.",
         "relmse_* = relative MSE against a path-traced reference at the same pixel centres (" +

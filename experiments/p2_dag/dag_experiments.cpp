@@ -180,7 +180,7 @@ const char* kGridNote =
     "solid. The paper does not say how it placed or scaled its models, so absolute counts differ; the ratio columns "
     "are the comparable figures.";
 
-// ---- Helpers ----
+// ---- Formatting ----
 
 std::string cube(uint32_t n) { return std::to_string(n) + "³"; }
 

@@ -79,7 +79,7 @@ nlohmann::json ExperimentSpec::to_json() const {
     j["scenes"] = scenes;
     j["size"] = {{"full", size}, {"quick", quick_size}};
     j["frames"] = {{"full", frames}, {"quick", quick_frames}};
-    if (needs_reference()) j["reference_spp"] = {{"full", reference_spp}, {"quick", quick_reference_spp}};
+    j["reference_spp"] = {{"full", reference_spp}, {"quick", quick_reference_spp}};
     if (slow.frame_ms > 0) j["slow"] = {{"frame_ms", slow.frame_ms}, {"frames", slow.frames}};
     j["interleave_variants"] = interleave_variants;
     j["variants"] = nlohmann::json::array();

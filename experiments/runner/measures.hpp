@@ -1,5 +1,5 @@
 #pragma once
-// Small helpers the experiments share to turn measurements into table cells: sizes
+// Small functions the experiments share to turn measurements into table cells: sizes
 // in MB (10⁶ B) and MiB (2²⁰ B), ratios that stay empty when the divisor is zero, the
 // median and mean of repeated timings, and the machine's load while timing.
 #include <algorithm>

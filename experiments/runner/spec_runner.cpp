@@ -44,7 +44,8 @@ nlohmann::json task_identity(const ExperimentSpec& spec, const SpecTask& t, bool
             {"task", t.to_json()},
             {"size", size_of(spec, quick)},
             {"frames", frames_of(spec, quick)},
-            {"reference_spp", spec.needs_reference() ? reference_spp_of(spec, quick) : 0},
+            {"reference_spp", reference_spp_of(spec, quick)},
+            {"slow", {spec.slow.frame_ms, spec.slow.frames}},
             {"measure_list", measures}};
 }
 
@@ -56,7 +57,7 @@ std::string identity_mismatch(const nlohmann::json& result, const nlohmann::json
     if (!result.contains("seed") || result["seed"] != identity["seed"])
         return "it was written with --seed " + result.value("seed", nlohmann::json()).dump() + ", not " +
                identity["seed"].dump();
-    for (const char* key : {"task", "size", "frames", "reference_spp", "measure_list", "statistic"})
+    for (const char* key : {"task", "size", "frames", "reference_spp", "slow", "measure_list", "statistic"})
         if (!result.contains(key) || result[key] != identity[key])
             return std::string("its '") + key + "' differs from this plan's (the spec changed since it ran); run the "
                                                 "task again";
@@ -100,7 +101,8 @@ std::string layer_digest(const Film& film, const std::string& layer) {
 // frame (A B C A B C …), each measured as the spec says.
 std::vector<nlohmann::json> run_technique_variants(const ExperimentSpec& spec, const SpecTask& task,
                                                    const std::vector<const TaskVariant*>& variants, const Scene& scene,
-                                                   const ExperimentContext& ctx, nlohmann::json& per_frame_out) {
+                                                   const ExperimentContext& ctx, nlohmann::json& per_frame_out,
+                                                   std::vector<std::string>& files) {
     const int size = size_of(spec, ctx.quick);
     const EyeCamera camera = spec_camera(scene, size);
     const size_t n = variants.size();
@@ -145,7 +147,6 @@ std::vector<nlohmann::json> run_technique_variants(const ExperimentSpec& spec, c
                 case Source::LayerMean: row[m.column] = mean_value(films[v], m.key); break;
                 case Source::ImageDigest: row[m.column] = layer_digest(films[v], m.key); break;
                 case Source::RelMse: {
-                    std::vector<std::string> files;
                     if (!reference)
                         reference = path_reference(ctx, scene, camera, reference_spp_of(spec, ctx.quick), files);
                     row[m.column] = relative_mse(films[v], *reference, m.key);
@@ -175,10 +176,19 @@ nlohmann::json run_planned_task(const ExperimentSpec& spec, const SpecTask& task
     for (const TaskVariant& v : task.variants)
         if (v.probe.empty()) techniques.push_back(&v);
     if (!techniques.empty()) {
-        const Scene& scene =
-            cache.get<Scene>("scene:" + task.scene, [&] { return open_scene(task.scene, ctx.assets).scene; });
-        for (nlohmann::json& row : run_technique_variants(spec, task, techniques, scene, ctx, per_frame))
-            rows.push_back(std::move(row));
+        // A scene that cannot be loaded (a shared asset not installed) leaves the task
+        // without rows and says why, as the probes do.
+        const Scene* scene = nullptr;
+        try {
+            scene = &cache.get<Scene>("scene:" + task.scene, [&] { return open_scene(task.scene, ctx.assets).scene; });
+        } catch (const Error& e) {
+            notes.push_back("Scene '" + task.scene + "' skipped: " + std::string(e.what()));
+        }
+        std::vector<std::string> reference_files;
+        if (scene)
+            for (nlohmann::json& row : run_technique_variants(spec, task, techniques, *scene, ctx, per_frame, reference_files))
+                rows.push_back(std::move(row));
+        for (std::string& f : reference_files) files.push_back(std::move(f));
     }
     for (const TaskVariant& v : task.variants) {
         if (v.probe.empty()) continue;
@@ -320,7 +330,7 @@ ExperimentOutput merge_spec_tasks(const ExperimentSpec& spec, const ExperimentCo
                                {"size", size_of(spec, ctx.quick)},
                                {"frames", frames_of(spec, ctx.quick)},
                                {"tasks", tasks.size()}};
-    if (spec.needs_reference()) out.config["effective"]["reference_spp"] = reference_spp_of(spec, ctx.quick);
+    out.config["effective"]["reference_spp"] = reference_spp_of(spec, ctx.quick);
     out.config["effective"]["tasks_merged"] = tasks.size() - missing.size();
     out.config["effective"]["tasks_missing"] = missing;
     out.config["effective"]["task_revisions"] = revisions;

@@ -1,5 +1,6 @@
 // Declared experiments: the plan, one task at a time, and merging tasks that ran
 // separately into the same tables as the one-command run.
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -100,6 +101,9 @@ TEST(SpecRunner, TasksRunSeparatelyMergeIntoTheTablesOfTheWholeRun) {
     // More photons are stored when more are emitted, and the two maps store the same photons.
     EXPECT_LT(a.rows[0].at("photons_stored").get<double>(), a.rows[2].at("photons_stored").get<double>());
     EXPECT_EQ(a.rows[0].at("photons_stored"), a.rows[1].at("photons_stored"));
+    // The path-traced reference the relMSE compares with is listed with the outputs.
+    EXPECT_TRUE(std::any_of(whole.files.begin(), whole.files.end(),
+                            [](const std::string& f) { return f.find("reference") != std::string::npos; }));
     EXPECT_EQ(whole.config.at("name"), "test-sweep");
     EXPECT_EQ(whole.config.at("effective").at("tasks"), 4);
 }
@@ -177,6 +181,18 @@ TEST(SpecRunner, InterleavedVariantsShareATask) {
     EXPECT_EQ(t.rows[1].at("variant"), "kd-tree");
     EXPECT_EQ(t.rows[0].at("digest").get<std::string>().size(), 16u);
     EXPECT_NE(t.rows[0].at("digest"), t.rows[2].at("digest"));  // more photons, another image
+}
+
+TEST(SpecRunner, ASceneThatCannotBeLoadedIsSkippedWithANote) {
+    ExperimentSpec spec = cornell_spec();
+    spec.scenes = {"conference"};  // a shared asset
+    ExperimentContext ctx = context(test::temp_dir("spec_missing_scene"));
+    ctx.assets = AssetPaths({ctx.output_dir / "no-such-assets"});
+    const ExperimentOutput out = run_spec(spec, ctx);
+    EXPECT_TRUE(out.tables.at(0).rows.empty());
+    EXPECT_TRUE(std::any_of(out.notes.begin(), out.notes.end(), [](const std::string& n) {
+        return n.find("Scene 'conference' skipped") != std::string::npos;
+    }));
 }
 
 size_t merged_rows(const ExperimentSpec& spec, const fs::path& dir, bool quick) {
