@@ -16,6 +16,7 @@
 #include "experiments/runner/experiment.hpp"
 #include "experiments/runner/measures.hpp"
 #include "experiments/runner/paper_figures.hpp"
+#include "experiments/runner/interleaved_render.hpp"
 #include "experiments/runner/path_reference.hpp"
 #include "experiments/runner/spec_functions.hpp"
 #include "core/scene/scene.hpp"
@@ -343,35 +344,23 @@ ProbeOutput fig8_probe(const ProbeCall& call) {
         settings.update(c.at("settings"));
         techniques.push_back(prepare_technique("photon", scene, Settings(settings, "pm-fig8 " + c.at("name").get<std::string>())));
     }
-    std::vector<std::vector<double>> ms(techniques.size());
-    std::vector<Film> films(techniques.size());
-    int frames = call.frames;
-    for (int f = 0; f < frames; ++f) {
-        double slowest = 0;
-        for (size_t i = 0; i < techniques.size(); ++i) {
-            std::vector<Film> out;
-            techniques[i]->render(ViewSet::mono(camera), out);
-            ms[i].push_back(techniques[i]->stats().get("render_ms"));
-            slowest = std::max(slowest, ms[i].back());
-            films[i] = std::move(out.at(0));
-        }
-        if (f == 0 && call.spec.slow.frame_ms > 0 && slowest > call.spec.slow.frame_ms)
-            frames = std::min(frames, call.spec.slow.frames);  // as the tables' slow variants
-    }
+    const InterleavedRender rendered =
+        render_interleaved(techniques, ViewSet::mono(camera), call.frames, {"render_ms"}, call.spec.slow);
     ProbeOutput out;
     const Film reference = path_reference(call.ctx, scene, camera, call.reference_spp, out.files);
     const double reference_indirect = mean_value(reference, "indirect");
     for (size_t i = 0; i < techniques.size(); ++i) {
         const std::string stem = compare[i].at("image");
-        for (std::string& f : write_images(call, stem, films[i], true)) out.files.push_back(std::move(f));
+        const Film& film = rendered.runs[i].films.at(0);
+        for (std::string& f : write_images(call, stem, film, true)) out.files.push_back(std::move(f));
         out.rows.push_back({{"variant", compare[i].at("name")},
                             {"image", stem + ".png"},
-                            {"frame_ms", median(ms[i])},
-                            {"mean_color", mean_value(films[i], "color")},
-                            {"mean_indirect", mean_value(films[i], "indirect")},
-                            {"indirect vs reference", mean_value(films[i], "indirect") / reference_indirect},
-                            {"relmse_indirect", relative_mse(films[i], reference, "indirect")},
-                            {"relmse_color", relative_mse(films[i], reference, "color")}});
+                            {"frame_ms", median(rendered.runs[i].per_frame.at("render_ms"))},
+                            {"mean_color", mean_value(film, "color")},
+                            {"mean_indirect", mean_value(film, "indirect")},
+                            {"indirect vs reference", mean_value(film, "indirect") / reference_indirect},
+                            {"relmse_indirect", relative_mse(film, reference, "indirect")},
+                            {"relmse_color", relative_mse(film, reference, "color")}});
     }
     write_png(call.ctx.output_dir / "fig8_reference.png", reference);
     write_png(call.ctx.output_dir / "fig8_reference_indirect.png", reference, 2.0f, "indirect");

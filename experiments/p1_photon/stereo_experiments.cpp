@@ -17,6 +17,7 @@
 #include "core/util/settings.hpp"
 #include "core/util/stats.hpp"
 #include "experiments/runner/experiment.hpp"
+#include "experiments/runner/interleaved_render.hpp"
 #include "experiments/runner/measures.hpp"
 #include "experiments/runner/paper_figures.hpp"
 #include "experiments/runner/path_reference.hpp"
@@ -82,18 +83,13 @@ std::vector<Run> measure(const ProbeCall& call, const Scene& scene, const ViewSe
     std::vector<std::unique_ptr<Technique>> techniques;
     for (const json& v : variants)
         techniques.push_back(prepare_technique("photon", scene, Settings(v, call.spec.name + " settings")));
-    const char* timed[] = {"render_ms", "left_ms", "right_ms", "claim_ms", "right_pass_ms"};
-    std::vector<std::map<std::string, std::vector<double>>> samples(n);
+    const std::vector<std::string> timed = {"render_ms", "left_ms", "right_ms", "claim_ms", "right_pass_ms"};
+    InterleavedRender rendered = render_interleaved(techniques, views, call.frames, timed);
     std::vector<Run> runs(n);
-    for (int f = 0; f < call.frames; ++f)
-        for (size_t v = 0; v < n; ++v) {
-            runs[v].films.clear();
-            techniques[v]->render(views, runs[v].films);
-            runs[v].stats = techniques[v]->stats();
-            for (const char* key : timed) samples[v][key].push_back(runs[v].stats.get(key));
-        }
     for (size_t v = 0; v < n; ++v) {
-        for (const char* key : timed) runs[v].stats.set(key, median(samples[v][key]));
+        runs[v].films = std::move(rendered.runs[v].films);
+        runs[v].stats = rendered.runs[v].last;
+        for (const std::string& key : timed) runs[v].stats.set(key, median(rendered.runs[v].per_frame.at(key)));
         call.ctx.say(variants[v].dump() + ": " + std::to_string(runs[v].stats.get("render_ms")) + " ms");
     }
     return runs;

@@ -9,6 +9,7 @@
 #include "core/image/image_metrics.hpp"
 #include "core/util/error.hpp"
 #include "core/util/stats.hpp"
+#include "experiments/runner/interleaved_render.hpp"
 #include "experiments/runner/measures.hpp"
 #include "experiments/runner/path_reference.hpp"
 #include "experiments/runner/result_writers.hpp"
@@ -115,47 +116,38 @@ std::vector<nlohmann::json> run_technique_variants(const ExperimentSpec& spec, c
         techniques.push_back(prepare_technique(v->technique, scene, given));
         prepared.push_back(techniques.back()->stats());
     }
-    std::vector<std::map<std::string, std::vector<double>>> per_frame(n);
-    std::vector<Stats> last(n);
-    std::vector<Film> films(n);
-    int frames = frames_of(spec, ctx.quick);
-    for (int f = 0; f < frames; ++f) {
-        double slowest = 0;
-        for (size_t v = 0; v < n; ++v) {
-            std::vector<Film> out;
-            techniques[v]->render(ViewSet::mono(camera), out);
-            last[v] = techniques[v]->stats();
-            for (const SpecMeasure& m : spec.measures)
-                if (m.source == Source::FrameStat) per_frame[v][m.key].push_back(last[v].get(m.key));
-            slowest = std::max(slowest, last[v].get("render_ms"));
-            films[v] = std::move(out.at(0));
-        }
-        if (f == 0 && spec.slow.frame_ms > 0 && slowest > spec.slow.frame_ms) frames = std::min(frames, spec.slow.frames);
-    }
+    std::vector<std::string> keys;
+    for (const SpecMeasure& m : spec.measures)
+        if (m.source == Source::FrameStat && std::find(keys.begin(), keys.end(), m.key) == keys.end())
+            keys.push_back(m.key);
+    const InterleavedRender rendered =
+        render_interleaved(techniques, ViewSet::mono(camera), frames_of(spec, ctx.quick), keys, spec.slow);
     std::optional<Film> reference;  // rendered (or read from the cache) once per task
     std::vector<nlohmann::json> rows;
     for (size_t v = 0; v < n; ++v) {
+        const InterleavedRun& run = rendered.runs[v];
+        const Film& film = run.films.at(0);
         nlohmann::json row = {{"variant", variants[v]->name}};
         for (const SpecMeasure& m : spec.measures) {
             switch (m.source) {
                 case Source::FrameStat:
-                    row[m.column] = spec.statistic == FrameStatistic::Mean ? mean(per_frame[v][m.key])
-                                                                           : median(per_frame[v][m.key]);
+                    row[m.column] = spec.statistic == FrameStatistic::Mean ? mean(run.per_frame.at(m.key))
+                                                                           : median(run.per_frame.at(m.key));
                     break;
                 case Source::PrepareStat: row[m.column] = prepared[v].get(m.key); break;
-                case Source::LastFrameStat: row[m.column] = last[v].get(m.key); break;
-                case Source::LayerMean: row[m.column] = mean_value(films[v], m.key); break;
-                case Source::ImageDigest: row[m.column] = layer_digest(films[v], m.key); break;
+                case Source::LastFrameStat: row[m.column] = run.last.get(m.key); break;
+                case Source::LayerMean: row[m.column] = mean_value(film, m.key); break;
+                case Source::ImageDigest: row[m.column] = layer_digest(film, m.key); break;
                 case Source::RelMse: {
                     if (!reference)
                         reference = path_reference(ctx, scene, camera, reference_spp_of(spec, ctx.quick), files);
-                    row[m.column] = relative_mse(films[v], *reference, m.key);
+                    row[m.column] = relative_mse(film, *reference, m.key);
                     break;
                 }
             }
         }
-        row["frames"] = frames;
-        per_frame_out[variants[v]->name] = per_frame[v];
+        row["frames"] = rendered.frames;
+        per_frame_out[variants[v]->name] = run.per_frame;
         rows.push_back(std::move(row));
     }
     return rows;
