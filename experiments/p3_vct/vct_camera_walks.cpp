@@ -1,8 +1,11 @@
 // P3 Figs. 9 and 10: frame time and structure memory along a camera walk through Sponza
 // and Sibenik — dense mip VCT, the cascades updating everything every frame or on their
 // schedule (the update strategy), and photon mapping. One task walks one scene with one
-// variant; both figures read the same walks (measured once per process).
+// variant; each figure walks in its own run. A partial merge leaves the cells of the
+// tasks that have not run empty.
+#include <functional>
 #include <map>
+#include <optional>
 #include "core/util/error.hpp"
 #include "core/util/settings.hpp"
 #include "core/util/stats.hpp"
@@ -26,22 +29,13 @@ struct WalkSeries {
 // The walk through the task's scene with `walk` rendering each frame; a missing scene is
 // skipped with a note.
 ProbeOutput walk_probe(const ProbeCall& call, const std::function<WalkSeries(const Scene&, const std::vector<EyeCamera>&)>& walk) {
-    const nlohmann::json what = {{"probe", call.variant.probe}, {"scene", call.task.scene},
-                                 {"settings", call.variant.settings}, {"size", call.size}, {"frames", call.frames}};
-    return measured_once(call, what, [&] {
-        ProbeOutput out;
-        const Scene* scene = nullptr;
-        try {
-            scene = &scene_named(call, call.task.scene);
-        } catch (const Error& e) {
-            out.notes.push_back(skip_note(call.ctx, call.task.scene, e.what()));
-            return out;
-        }
-        const WalkSeries s = walk(*scene, walk_cameras(camera_walk(call.task.scene), call.size, call.frames));
-        call.ctx.say(call.task.scene + ", " + call.variant.name + ": mean frame " + std::to_string(mean(s.total_ms)) + " ms");
-        out.rows.push_back(s.to_row());
-        return out;
-    });
+    ProbeOutput out;
+    const Scene* scene = scene_or_skip(call, call.task.scene, out);
+    if (!scene) return out;
+    const WalkSeries s = walk(*scene, walk_cameras(camera_walk(call.task.scene), call.size, call.frames));
+    call.ctx.say(call.task.scene + ", " + call.variant.name + ": mean frame " + std::to_string(mean(s.total_ms)) + " ms");
+    out.rows.push_back(s.to_row());
+    return out;
 }
 
 // A cone-traced variant (setting "vct", dense resolution from the axis) along the walk.
@@ -92,26 +86,57 @@ struct WalkRun {
     std::vector<double> total_ms, update_ms, injection_ms, bytes, rss;
 };
 
-// Every walked scene (in plan order) with its variants' runs; skipped scenes have none.
-std::vector<std::pair<std::string, std::vector<WalkRun>>> walks_of(const SpecReduction& r) {
+// One walked scene: each variant of the spec, in its order, with its run or null when its
+// task has not been merged.
+struct SceneWalks {
+    std::string scene;
+    std::vector<std::pair<std::string, std::optional<WalkRun>>> variants;
+    const WalkRun* run(const std::string& variant) const {
+        for (const auto& [name, run] : variants)
+            if (name == variant && run) return &*run;
+        return nullptr;
+    }
+    std::vector<WalkRun> runs() const {  // the variants that ran
+        std::vector<WalkRun> out;
+        for (const auto& [name, run] : variants)
+            if (run) out.push_back(*run);
+        return out;
+    }
+};
+
+// Every scene with at least one walk (in plan order); scenes skipped or not merged have
+// none. `notes` gains, per scene, the variants without a walk.
+std::vector<SceneWalks> walks_of(const SpecReduction& r, std::vector<std::string>& notes) {
     require_rows(r);
-    std::vector<std::pair<std::string, std::vector<WalkRun>>> walks;
+    std::vector<SceneWalks> walks;
     for (const TaskResult& t : r.tasks) {
         if (t.rows.empty()) continue;
-        if (walks.empty() || walks.back().first != t.task.scene) walks.push_back({t.task.scene, {}});
-        const nlohmann::json& row = t.rows.at(0);
-        using Series = std::vector<double>;
-        walks.back().second.push_back({row.at("variant").get<std::string>(), row.at("total_ms").get<Series>(),
-                                       row.at("update_ms").get<Series>(), row.at("injection_ms").get<Series>(),
-                                       row.at("bytes").get<Series>(), row.at("rss").get<Series>()});
+        if (walks.empty() || walks.back().scene != t.task.scene) {
+            walks.push_back({t.task.scene, {}});
+            for (const SpecVariant& v : r.spec.variants) walks.back().variants.push_back({v.name, std::nullopt});
+        }
+        for (const nlohmann::json& row : t.rows) {
+            using Series = std::vector<double>;
+            WalkRun run{row.at("variant").get<std::string>(), row.at("total_ms").get<Series>(),
+                        row.at("update_ms").get<Series>(),    row.at("injection_ms").get<Series>(),
+                        row.at("bytes").get<Series>(),        row.at("rss").get<Series>()};
+            for (auto& [name, slot] : walks.back().variants)
+                if (name == run.name) slot = std::move(run);
+        }
+    }
+    for (const SceneWalks& w : walks) {
+        std::string absent;
+        for (const auto& [name, run] : w.variants)
+            if (!run) absent += (absent.empty() ? "'" : ", '") + name + "'";
+        if (!absent.empty())
+            notes.push_back(w.scene + ": no walk for " + absent + " (task not merged); its cells are empty.");
     }
     return walks;
 }
 
-const WalkRun& run_named(const std::vector<WalkRun>& runs, const std::string& name) {
-    for (const WalkRun& r : runs)
-        if (r.name == name) return r;
-    throw Error("vct walks", "no variant '" + name + "'");
+// `value` of `run`, or null without a run.
+nlohmann::json cell(const WalkRun* run, const std::function<double(const WalkRun&)>& value) {
+    return run ? nlohmann::json(value(*run)) : nlohmann::json();
 }
 
 std::vector<double> after_first(const std::vector<double>& v) {
@@ -139,51 +164,62 @@ ExperimentOutput fig9(const SpecReduction& r) {
     summary.columns = {"scene", "variant", "frame_ms", "update_ms", "injection_ms", "fps", "paper"};
     // Fig. 9 prints no values: the paper's findings from its text.
     const PaperFigures& paper = paper_figures("p3/fig9");
-    for (const auto& [scene, runs] : walks_of(r)) {
+    std::vector<std::string> absent;
+    for (const SceneWalks& walk : walks_of(r, absent)) {
+        const std::string& scene = walk.scene;
         ResultTable t;
         t.title = "Fig. 9 — frame time along a walk through " + scene;
         t.columns = {"frame"};
-        for (const WalkRun& run : runs) {
-            t.columns.push_back(run.name + " ms");
-            t.columns.push_back(run.name + " fps");
+        for (const auto& [name, run] : walk.variants) {
+            t.columns.push_back(name + " ms");
+            t.columns.push_back(name + " fps");
         }
-        for (size_t f = 0; f < runs[0].total_ms.size(); ++f) {
+        for (size_t f = 0; f < size_t(r.frames()); ++f) {
             nlohmann::json row = {{"frame", f + 1}};
-            for (const WalkRun& run : runs) {
-                row[run.name + " ms"] = run.total_ms[f];
-                row[run.name + " fps"] = 1000.0 / run.total_ms[f];
+            for (const auto& [name, run] : walk.variants) {
+                const bool measured = run && f < run->total_ms.size();
+                row[name + " ms"] = measured ? nlohmann::json(run->total_ms[f]) : nlohmann::json();
+                row[name + " fps"] = measured ? nlohmann::json(1000.0 / run->total_ms[f]) : nlohmann::json();
             }
             t.rows.push_back(row);
         }
         out.tables.push_back(std::move(t));
         out.plots.push_back({"fig9_" + scene, walk_plot("Fig. 9 — frame time along the walk through " + scene,
-                                                         "frame time (ms, log scale)", runs,
+                                                         "frame time (ms, log scale)", walk.runs(),
                                                          [](const WalkRun& w, size_t f) { return w.total_ms[f]; })});
-        for (const WalkRun& run : runs) {
-            const double ms = mean(after_first(run.total_ms));
+        for (const auto& [name, run] : walk.variants) {
+            const WalkRun* w = run ? &*run : nullptr;
             // The paper's finding for the curve this variant stands for.
-            const char* curve = run.name == "dense mip"                   ? "VXGI"
-                                : run.name == "cascaded, update strategy" ? "cascaded with update strategy"
-                                : run.name == "photon mapping"            ? "PM"
-                                                                          : "cascaded without update strategy";
-            summary.rows.push_back({{"scene", scene},
-                                    {"variant", run.name},
-                                    {"frame_ms", ms},
-                                    {"update_ms", mean(after_first(run.update_ms))},
-                                    {"injection_ms", run.name == "photon mapping" ? nlohmann::json()
-                                                                                 : nlohmann::json(mean(after_first(run.injection_ms)))},
-                                    {"fps", 1000.0 / ms},
-                                    {"paper", paper.row({{"curve", curve}}).text("finding")}});
+            const char* curve = name == "dense mip"                   ? "VXGI"
+                                : name == "cascaded, update strategy" ? "cascaded with update strategy"
+                                : name == "photon mapping"            ? "PM"
+                                                                      : "cascaded without update strategy";
+            summary.rows.push_back(
+                {{"scene", scene},
+                 {"variant", name},
+                 {"frame_ms", cell(w, [](const WalkRun& x) { return mean(after_first(x.total_ms)); })},
+                 {"update_ms", cell(w, [](const WalkRun& x) { return mean(after_first(x.update_ms)); })},
+                 {"injection_ms", name == "photon mapping"
+                                      ? nlohmann::json()
+                                      : cell(w, [](const WalkRun& x) { return mean(after_first(x.injection_ms)); })},
+                 {"fps", cell(w, [](const WalkRun& x) { return 1000.0 / mean(after_first(x.total_ms)); })},
+                 {"paper", paper.row({{"curve", curve}}).text("finding")}});
         }
-        const double everything = mean(after_first(run_named(runs, "cascaded, update everything").update_ms));
-        const double strategy = mean(after_first(run_named(runs, "cascaded, update strategy").update_ms));
+        const WalkRun* everything = walk.run("cascaded, update everything");
+        const WalkRun* strategy = walk.run("cascaded, update strategy");
+        nlohmann::json ratio;
+        if (everything && strategy) {
+            const double e = mean(after_first(everything->update_ms)), s = mean(after_first(strategy->update_ms));
+            ratio = s > 0 ? e / s : 0.0;
+        }
         summary.rows.push_back({{"scene", scene}, {"variant", "update time: everything ÷ strategy"}, {"frame_ms", nullptr},
-                                {"update_ms", strategy > 0 ? everything / strategy : 0.0}, {"injection_ms", nullptr},
+                                {"update_ms", ratio}, {"injection_ms", nullptr},
                                 {"fps", nullptr},
                                 {"paper", paper.row({{"curve", "update time VXGI / cascaded"}}).text("finding")}});
     }
     out.tables.push_back(std::move(summary));
-    out.notes = quick_notes(r.ctx);
+    out.notes = quick_notes(r, {.images = true, .frames = true, .cones = true});
+    out.notes.insert(out.notes.end(), absent.begin(), absent.end());
     return out;
 }
 
@@ -198,31 +234,43 @@ ExperimentOutput fig10(const SpecReduction& r) {
         if (!curve) return nlohmann::json();
         return nlohmann::json(paper_figures("p3/fig10").row({{"curve", curve}}).number("memory over VXGI"));
     };
-    for (const auto& [scene, runs] : walks_of(r)) {
+    std::vector<std::string> absent;
+    for (const SceneWalks& walk : walks_of(r, absent)) {
+        const std::string& scene = walk.scene;
+        // The process RSS column follows the last variant of the spec.
+        const WalkRun* last = walk.variants.back().second ? &*walk.variants.back().second : nullptr;
         ResultTable t;
         t.title = "Fig. 10 — memory along the walk through " + scene + " (MB = 10⁶ B, of each structure; process RSS)";
         t.columns = {"frame"};
-        for (const WalkRun& run : runs) t.columns.push_back(run.name + " (MB)");
+        for (const auto& [name, run] : walk.variants) t.columns.push_back(name + " (MB)");
         t.columns.push_back("process RSS (MB)");
-        for (size_t f = 0; f < runs[0].bytes.size(); ++f) {
+        for (size_t f = 0; f < size_t(r.frames()); ++f) {
             nlohmann::json row = {{"frame", f + 1}};
-            for (const WalkRun& run : runs) row[run.name + " (MB)"] = mb(run.bytes[f]);
-            row["process RSS (MB)"] = mb(runs.back().rss[f]);
+            for (const auto& [name, run] : walk.variants)
+                row[name + " (MB)"] =
+                    run && f < run->bytes.size() ? nlohmann::json(mb(run->bytes[f])) : nlohmann::json();
+            row["process RSS (MB)"] = last && f < last->rss.size() ? nlohmann::json(mb(last->rss[f])) : nlohmann::json();
             t.rows.push_back(row);
         }
         out.tables.push_back(std::move(t));
         out.plots.push_back({"fig10_" + scene, walk_plot("Fig. 10 — structure memory along the walk through " + scene,
-                                                          "memory (MB = 10⁶ B, log scale)", runs,
+                                                          "memory (MB = 10⁶ B, log scale)", walk.runs(),
                                                           [](const WalkRun& w, size_t f) { return mb(w.bytes[f]); })});
-        for (const WalkRun& run : runs)
-            summary.rows.push_back({{"scene", scene},
-                                    {"variant", run.name},
-                                    {"mean structure (MB)", mb(mean(run.bytes))},
-                                    {"over_dense", mean(run.bytes) / mean(runs[0].bytes)},
-                                    {"paper over_dense", paper_over_dense(run.name)}});
+        const WalkRun* dense = walk.run("dense mip");
+        for (const auto& [name, run] : walk.variants) {
+            const WalkRun* w = run ? &*run : nullptr;
+            const WalkRun* over = dense ? w : nullptr;  // no ratio without the dense walk
+            summary.rows.push_back(
+                {{"scene", scene},
+                 {"variant", name},
+                 {"mean structure (MB)", cell(w, [](const WalkRun& x) { return mb(mean(x.bytes)); })},
+                 {"over_dense", cell(over, [&](const WalkRun& x) { return mean(x.bytes) / mean(dense->bytes); })},
+                 {"paper over_dense", paper_over_dense(name)}});
+        }
     }
     out.tables.push_back(std::move(summary));
-    out.notes = quick_notes(r.ctx);
+    out.notes = quick_notes(r, {.images = true, .frames = true, .cones = true});
+    out.notes.insert(out.notes.end(), absent.begin(), absent.end());
     return out;
 }
 

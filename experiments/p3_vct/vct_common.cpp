@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <map>
-#include <mutex>
 #include "core/image/image_io.hpp"
 #include "core/util/error.hpp"
 #include "core/util/settings.hpp"
@@ -109,6 +108,15 @@ const Scene& scene_named(const ProbeCall& call, const std::string& name) {
     });
 }
 
+const Scene* scene_or_skip(const ProbeCall& call, const std::string& name, ProbeOutput& out) {
+    try {
+        return &scene_named(call, name);
+    } catch (const Error& e) {
+        out.notes.push_back(skip_note(call.ctx, name, e.what()));
+        return nullptr;
+    }
+}
+
 std::string scene_of(const ProbeCall& call) { return call.setting<std::string>("scene", call.task.scene); }
 
 EyeCamera scene_camera(const Scene& scene, int size) {
@@ -155,7 +163,7 @@ nlohmann::json vct_settings(const ProbeCall& call) {
 
 std::unique_ptr<Technique> make_vct(const Scene& scene, nlohmann::json settings, const ExperimentContext& ctx) {
     settings["seed"] = ctx.seed;
-    if (ctx.quick && !settings.contains("injection_cones")) settings["injection_cones"] = 8;
+    if (ctx.quick && !settings.contains("injection_cones")) settings["injection_cones"] = kQuickInjectionCones;
     return prepare_technique("vct", scene, Settings(settings, "vct experiment settings"));
 }
 
@@ -177,29 +185,71 @@ std::string skip_note(const ExperimentContext& ctx, const std::string& scene, co
     return "scene '" + scene + "' skipped: " + why;
 }
 
-std::vector<std::string> quick_notes(const ExperimentContext& ctx) {
-    if (!ctx.quick) return {};
-    return {"Quick run: dense_resolution 64 (the finest voxel of both structures is 1/64 of the scene), 48² images "
-            "(32² along the camera walks), 8 voxel-bounce cones instead of 16, fewer frames; at this size the dense "
-            "texture is small, so memory and time ratios favour it."};
+namespace {
+
+std::string value_text(const nlohmann::json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
+
+// Each setting of the axis with its values in plan order (an axis of objects gives
+// every key of its objects).
+std::vector<std::pair<std::string, std::vector<std::string>>> axis_values(const SpecAxis& axis,
+                                                                          const std::vector<nlohmann::json>& values) {
+    std::vector<std::pair<std::string, std::vector<std::string>>> out;
+    auto add = [&](const std::string& key, const nlohmann::json& v) {
+        auto it = std::find_if(out.begin(), out.end(), [&](const auto& kv) { return kv.first == key; });
+        if (it == out.end()) it = out.insert(out.end(), {key, {}});
+        it->second.push_back(value_text(v));
+    };
+    for (const nlohmann::json& v : values) {
+        if (!axis.setting.empty()) add(axis.setting, v);
+        else
+            for (auto item = v.begin(); item != v.end(); ++item) add(item.key(), item.value());
+    }
+    return out;
 }
 
-ProbeOutput measured_once(const ProbeCall& call, const nlohmann::json& what, const std::function<ProbeOutput()>& measure) {
-    static std::mutex mutex;
-    static std::map<std::string, ProbeOutput> measured;
-    const std::string key = nlohmann::json{{"what", what},
-                                           {"quick", call.ctx.quick},
-                                           {"assets", call.ctx.assets.describe()},
-                                           {"seed", call.ctx.seed},
-                                           {"threads", call.ctx.threads}}
-                                .dump();
-    {
-        std::lock_guard lock(mutex);
-        if (auto it = measured.find(key); it != measured.end()) return it->second;
+std::string listed(const std::vector<std::string>& values) {
+    std::string out;
+    for (const std::string& v : values) out += (out.empty() ? "" : ", ") + v;
+    return out;
+}
+
+}  // namespace
+
+std::vector<std::string> quick_notes(const SpecReduction& r, QuickNoteParts parts) {
+    if (!r.ctx.quick) return {};
+    const ExperimentSpec& s = r.spec;
+    std::vector<std::string> changes;
+    bool dense_smaller = false;
+    for (const SpecAxis& axis : s.axes) {
+        const auto quick = axis_values(axis, axis.quick), full = axis_values(axis, axis.full);
+        for (const auto& [key, values] : quick) {
+            auto f = std::find_if(full.begin(), full.end(), [&](const auto& kv) { return kv.first == key; });
+            if (f != full.end() && f->second == values) continue;
+            std::string change = key + " " + listed(values);
+            if (f != full.end()) change += " (full: " + listed(f->second) + ")";
+            if (key == "dense_resolution") {
+                change += " where the variant does not fix its own";
+                dense_smaller = true;
+            }
+            changes.push_back(change);
+        }
     }
-    ProbeOutput out = measure();
-    std::lock_guard lock(mutex);
-    return measured.emplace(key, std::move(out)).first->second;
+    if (parts.images && s.quick_size != s.size)
+        changes.push_back("images " + std::to_string(s.quick_size) + "² (full: " + std::to_string(s.size) + "²)");
+    if (parts.frames && s.quick_frames != s.frames)
+        changes.push_back(std::to_string(s.quick_frames) + " frames per task (full: " + std::to_string(s.frames) + ")");
+    if (parts.reference_spp && s.quick_reference_spp != s.reference_spp)
+        changes.push_back("reference " + std::to_string(s.quick_reference_spp) + " samples per pixel (full: " +
+                          std::to_string(s.reference_spp) + ")");
+    if (parts.cones) {
+        const SettingsSchema& schema = TechniqueRegistry::builtin().find("vct")->settings_schema();
+        changes.push_back(std::to_string(kQuickInjectionCones) + " voxel-bounce cones per voxel face (full: " +
+                          schema.spec("injection_cones").default_text() + ")");
+    }
+    if (changes.empty()) return {};
+    std::string note = "Quick run: " + listed(changes) + ".";
+    if (dense_smaller) note += " At this size the dense texture is small, so memory and time ratios favour it.";
+    return {note};
 }
 
 void require_rows(const SpecReduction& r) {

@@ -1,9 +1,8 @@
 #pragma once
 // What the P3 experiments share: the scenes they build (a Stanford model in the Cornell
 // box, Sponza with glossy stone, two rooms behind a thin wall), the `vct` technique as
-// a probe prepares it, and a process-wide memo for measurements that several
-// experiments report (Tables 1, 3 and 5 measure the same structures; Figs. 9 and 10 the
-// same camera walks).
+// a probe prepares it, and what the reducers say about quick runs. Every run measures
+// its own figures; what a run's tasks share (a loaded scene) lives in its call.cache.
 #include <functional>
 #include <memory>
 #include <string>
@@ -23,6 +22,9 @@ namespace gilab::vct {
 //   anything else    the scene as `gilab render` opens it.
 // Throws Error when its mesh is missing.
 const Scene& scene_named(const ProbeCall& call, const std::string& name);
+// The scene `name`, or null with a skip note (skip_note) added to `out` when it cannot be
+// loaded.
+const Scene* scene_or_skip(const ProbeCall& call, const std::string& name, ProbeOutput& out);
 
 // The probe's scene: its setting "scene", else the task's scene.
 std::string scene_of(const ProbeCall& call);
@@ -51,8 +53,9 @@ Vec3 scene_viewer(const Scene& scene);
 // resolution (setting "dense_resolution", an axis with a quick value) where the variant
 // does not fix its own, and the run's seed.
 nlohmann::json vct_settings(const ProbeCall& call);
-// `vct` prepared on `scene`. Quick runs are smoke checks: half the paper's 16
-// voxel-bounce cones unless the settings say otherwise.
+// `vct` prepared on `scene`. Quick runs are smoke checks: kQuickInjectionCones
+// voxel-bounce cones (half the paper's 16) unless the settings say otherwise.
+constexpr int kQuickInjectionCones = 8;
 std::unique_ptr<Technique> make_vct(const Scene& scene, nlohmann::json settings, const ExperimentContext& ctx);
 
 Film render(Technique& t, const EyeCamera& camera);
@@ -62,14 +65,15 @@ void save_images(const ExperimentContext& ctx, std::vector<std::string>& files, 
 // "scene 'NAME' skipped: why" — the note a probe returns when a mesh is missing.
 std::string skip_note(const ExperimentContext& ctx, const std::string& scene, const std::string& why);
 
-// The note every quick run of the rendering experiments carries.
-std::vector<std::string> quick_notes(const ExperimentContext& ctx);
-
-// A probe's output measured once per process for `what` and every input of the context
-// that changes the figures (quick sizes, the scene files found, the seed, the thread
-// count the times were taken at): a second experiment asking for the same measurement
-// gets the same rows, another context measures again.
-ProbeOutput measured_once(const ProbeCall& call, const nlohmann::json& what, const std::function<ProbeOutput()>& measure);
+// What a quick run's note names besides the axis settings it shrinks: the spec's image
+// side, its frames per task and its reference samples where the probes use them, and the
+// voxel-bounce cones where they cone trace.
+struct QuickNoteParts {
+    bool images = false, frames = false, reference_spp = false, cones = false;
+};
+// The note a quick run carries (none in a full run), from the spec: every axis setting
+// whose quick values differ from the full ones, then `parts`.
+std::vector<std::string> quick_notes(const SpecReduction& r, QuickNoteParts parts);
 
 // Throws when no task has a row (every scene skipped): there is no table to print.
 void require_rows(const SpecReduction& r);

@@ -37,11 +37,13 @@ const Reference& reference_of(const ProbeCall& call, const Scene& scene, const E
     });
 }
 
-// The reference itself as a row of Fig. 11 (its relMSE is 0 by definition).
+// The reference itself as a row of Fig. 11 (its relMSE is 0 by definition). A missing
+// scene is skipped with a note.
 ProbeOutput reference_image_probe(const ProbeCall& call) {
-    const Scene& scene = scene_named(call, scene_of(call));
-    const Reference& ref = reference_of(call, scene, probe_camera(call, scene));
     ProbeOutput out;
+    const Scene* scene = scene_or_skip(call, scene_of(call), out);
+    if (!scene) return out;
+    const Reference& ref = reference_of(call, *scene, probe_camera(call, *scene));
     out.rows.push_back({{"image", call.variant.name}, {"relmse_color", 0.0}, {"relmse_indirect", 0.0},
                         {"mean_color", mean_value(ref.film)}, {"mean_indirect", mean_value(ref.film, "indirect")},
                         {"frame_ms", nullptr}});
@@ -55,14 +57,8 @@ ProbeOutput reference_image_probe(const ProbeCall& call) {
 // reference. A missing scene is skipped with a note.
 ProbeOutput vct_image_probe(const ProbeCall& call) {
     ProbeOutput out;
-    const std::string name = scene_of(call);
-    const Scene* scene = nullptr;
-    try {
-        scene = &scene_named(call, name);
-    } catch (const Error& e) {
-        out.notes.push_back(skip_note(call.ctx, name, e.what()));
-        return out;
-    }
+    const Scene* scene = scene_or_skip(call, scene_of(call), out);
+    if (!scene) return out;
     const EyeCamera camera = probe_camera(call, *scene);
     auto tech = make_vct(*scene, vct_settings(call), call.ctx);
     const Film f = render(*tech, camera);
@@ -82,7 +78,8 @@ ProbeOutput vct_image_probe(const ProbeCall& call) {
 }
 
 // The images' rows under `title` with `columns`.
-ExperimentOutput image_table(const SpecReduction& r, const std::string& title, std::vector<std::string> columns) {
+ExperimentOutput image_table(const SpecReduction& r, const std::string& title, std::vector<std::string> columns,
+                             QuickNoteParts quick) {
     require_rows(r);
     ExperimentOutput out;
     ResultTable t{title, std::move(columns), {}};
@@ -92,7 +89,7 @@ ExperimentOutput image_table(const SpecReduction& r, const std::string& title, s
         t.rows.push_back(std::move(cells));
     }
     out.tables.push_back(std::move(t));
-    out.notes = quick_notes(r.ctx);
+    out.notes = quick_notes(r, quick);
     return out;
 }
 
@@ -115,11 +112,13 @@ void register_images(ExperimentRegistry& registry) {
     add_probe("vct-image", vct_image_probe);
     add_reducer("vct-fig11", [](const SpecReduction& r) {
         return image_table(r, "Fig. 11 — Sponza: cone-traced images against a path-traced reference",
-                           {"image", "relmse_color", "relmse_indirect", "mean_color", "mean_indirect", "frame_ms"});
+                           {"image", "relmse_color", "relmse_indirect", "mean_color", "mean_indirect", "frame_ms"},
+                           {.images = true, .reference_spp = true, .cones = true});
     });
     add_reducer("vct-fig12-13", [](const SpecReduction& r) {
         return image_table(r, "Figs. 12/13 — diffuse (Sponza) and specular (Cornell box + glossy Buddha) cones on and off",
-                           {"image", "mean_color", "mean_indirect", "mean_specular", "frame_ms"});
+                           {"image", "mean_color", "mean_indirect", "mean_specular", "frame_ms"},
+                           {.images = true, .cones = true});
     });
     registry.add(declared_experiment({
         .name = "vct-fig11",

@@ -18,9 +18,12 @@ const char* kPhases[] = {"primary_ms", "update_ms", "injection_ms", "direct_ms",
 // scene: `call.frames` frames at the scene camera, interleaved, then `walk_frames` along
 // the walk. One row per structure: each phase's median (total without the update, as the
 // paper gives it), the update's median on the walk (frames after the first, which
-// builds), and the structure's bytes.
+// builds), and the structure's bytes. A missing scene is skipped with a note.
 ProbeOutput phase_times_probe(const ProbeCall& call) {
-    const Scene& scene = scene_named(call, call.task.scene);
+    ProbeOutput out;
+    const Scene* loaded = scene_or_skip(call, call.task.scene, out);
+    if (!loaded) return out;
+    const Scene& scene = *loaded;
     const EyeCamera camera = scene_camera(scene, call.size);
     const nlohmann::json structures = call.setting<nlohmann::json>("structures");
     std::vector<std::unique_ptr<Technique>> techniques;
@@ -42,7 +45,6 @@ ProbeOutput phase_times_probe(const ProbeCall& call) {
         }
     const std::vector<EyeCamera> walk =
         walk_cameras(camera_walk("sponza"), call.size, call.setting<int>("walk_frames"));
-    ProbeOutput out;
     for (size_t v = 0; v < n; ++v) {
         nlohmann::json settings = structures[v].at("vct");
         settings["dense_resolution"] = call.setting<int>("dense_resolution");
@@ -61,11 +63,23 @@ ProbeOutput phase_times_probe(const ProbeCall& call) {
     return out;
 }
 
-// The probe's two rows (dense, cascaded) as the paper's table: one row per phase.
+// The probe's rows of the spec's two structures (dense first, cascaded second, as its
+// setting "structures" lists them) as the paper's table: one row per phase, a cell empty
+// where its structure has no row.
 ExperimentOutput table7(const SpecReduction& r) {
+    require_rows(r);
     const std::vector<nlohmann::json> rows = all_rows(r);
-    const nlohmann::json& dense = rows.at(0);
-    const nlohmann::json& cascaded = rows.at(1);
+    const nlohmann::json& structures = r.spec.variants.at(0).settings.at("structures");
+    auto row_of = [&](size_t i) -> const nlohmann::json* {
+        for (const nlohmann::json& row : rows)
+            if (row.at("variant") == structures.at(i).at("name")) return &row;
+        return nullptr;
+    };
+    const nlohmann::json* dense = row_of(0);
+    const nlohmann::json* cascaded = row_of(1);
+    auto value = [](const nlohmann::json* row, const std::string& key) {
+        return row ? nlohmann::json(row->at(key)) : nlohmann::json();
+    };
     ExperimentOutput out;
     ResultTable t;
     t.title = "Table 7 — per-frame time by phase (ms), Sponza, dense mip VCT vs cascaded";
@@ -77,20 +91,26 @@ ExperimentOutput table7(const SpecReduction& r) {
         {"update_ms", "dynamic update"}};
     for (const char* k : kPhases) {
         const std::string key = k;
-        const double d = dense.at(key), c = cascaded.at(key);
+        nlohmann::json ratio;
+        if (dense && cascaded) {
+            const double d = dense->at(key), c = cascaded->at(key);
+            ratio = d > 0 ? c / d : 0.0;
+        }
         const PaperRow& paper = paper_figures("p3/table7").row({{"phase", paper_phase.at(key)}});
         const std::string phase = key == "update_ms"  ? "update_ms (per frame on the walk, not in the total)"
                                   : key == "total_ms" ? "total_ms (without the update)"
                                                       : key;
-        t.rows.push_back({{"phase", phase}, {"dense_ms", d}, {"cascaded_ms", c},
-                          {"cascaded_over_dense", d > 0 ? c / d : 0.0}, {"paper VXGI_ms", paper.number("VXGI ms")},
+        t.rows.push_back({{"phase", phase}, {"dense_ms", value(dense, key)}, {"cascaded_ms", value(cascaded, key)},
+                          {"cascaded_over_dense", ratio}, {"paper VXGI_ms", paper.number("VXGI ms")},
                           {"paper cascaded_ms", paper.number("cascaded ms")}});
     }
     out.tables.push_back(std::move(t));
-    out.notes = quick_notes(r.ctx);
-    out.notes.push_back("Structure memory at the scene camera: dense " +
-                        std::to_string(mb(dense.at("structure_bytes").get<double>())) + " MB, cascaded " +
-                        std::to_string(mb(cascaded.at("structure_bytes").get<double>())) + " MB (10⁶ B).");
+    out.notes = quick_notes(r, {.images = true, .frames = true, .cones = true});
+    auto memory = [](const nlohmann::json* row) {
+        return row ? std::to_string(mb(row->at("structure_bytes").get<double>())) + " MB" : std::string("not measured");
+    };
+    out.notes.push_back("Structure memory at the scene camera: dense " + memory(dense) + ", cascaded " + memory(cascaded) +
+                        " (MB = 10⁶ B).");
     return out;
 }
 

@@ -39,10 +39,17 @@ std::vector<EyeCamera> slow_walk(int size, int frames) {
 
 // One `vct` variant (setting "vct", the axis's dense resolution) along the slow walk of
 // "walk_frames" frames at "walk_size": the mean frame-to-frame change of the direct and
-// the indirect layer.
+// the indirect layer. The walk is laid down Sponza's nave, so setting "scene" (the
+// task's scene when absent) must be "sponza"; a missing Sponza is skipped with a note.
 ProbeOutput flicker_probe(const ProbeCall& call) {
-    const Scene& scene = scene_named(call, scene_of(call));
-    auto tech = make_vct(scene, vct_settings(call), call.ctx);
+    const std::string name = scene_of(call);
+    if (name != "sponza")
+        throw Error(call.spec.name, "variant '" + call.variant.name + "': setting 'scene' is '" + name +
+                                        "', but the flicker walk is laid down Sponza's nave (scene 'sponza' only)");
+    ProbeOutput out;
+    const Scene* scene = scene_or_skip(call, name, out);
+    if (!scene) return out;
+    auto tech = make_vct(*scene, vct_settings(call), call.ctx);
     std::vector<Film> films;
     for (const EyeCamera& c : slow_walk(call.setting<int>("walk_size"), call.setting<int>("walk_frames")))
         films.push_back(render(*tech, c));
@@ -51,7 +58,6 @@ ProbeOutput flicker_probe(const ProbeCall& call) {
         dd.push_back(change(films[i - 1], films[i], "direct"));
         di.push_back(change(films[i - 1], films[i], "indirect"));
     }
-    ProbeOutput out;
     out.rows.push_back({{"direct_change", mean(dd)}, {"indirect_change", mean(di)},
                         {"indirect_minus_direct", mean(di) - mean(dd)}});
     return out;
@@ -88,8 +94,10 @@ ProbeOutput leak_probe(const ProbeCall& call) {
     return out;
 }
 
-// The flicker rows (variant, changes) and the leak rows (technique, means) as two tables.
+// The flicker rows (variant, changes) and the leak rows (technique, means) as two tables;
+// a table whose probes were all skipped is empty (the skip notes say why).
 ExperimentOutput stability(const SpecReduction& r) {
+    require_rows(r);
     ExperimentOutput out;
     ResultTable flicker{"Flicker — mean relative change between consecutive frames while walking (Sponza)",
                         {"variant", "direct_change", "indirect_change", "indirect_minus_direct"}, {}};
@@ -102,7 +110,7 @@ ExperimentOutput stability(const SpecReduction& r) {
         t.rows.push_back(std::move(cells));
     }
     out.tables = {std::move(flicker), std::move(leak)};
-    out.notes = quick_notes(r.ctx);
+    out.notes = quick_notes(r, {.cones = true});
     return out;
 }
 

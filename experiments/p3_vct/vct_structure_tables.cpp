@@ -3,6 +3,8 @@
 // (Tables 1–2), timed (3–4) and weighed (5–6), on the Stanford models in the Cornell box
 // (odd tables) and on Sponza and Sibenik (even tables). One probe measures every
 // structure of one scene and resolution; one reducer per quantity lays out each pair.
+// Each table is its own run: Tables 1, 3 and 5 (2, 4 and 6) measure the same structures
+// but not together.
 // The comparison structures come from accel/ and are fed the same conservative
 // voxelization (core/voxel/voxelizer).
 #include <algorithm>
@@ -222,37 +224,29 @@ SceneFigures measure_structures(const ExperimentContext& ctx, const Scene& scene
 nlohmann::json number_or_null(double x) { return std::isnan(x) ? nlohmann::json() : nlohmann::json(x); }
 
 // One scene (setting "scene") at one resolution (setting "resolution", voxels per axis),
-// each time the median of "repeats" runs: one row per structure. Measured once per
-// process, so the three tables of a scene set report the same run.
+// each time the median of "repeats" runs: one row per structure. Each table of a scene
+// set measures its structures in its own run.
 ProbeOutput structures_probe(const ProbeCall& call) {
     const std::string name = call.setting<std::string>("scene");
     const int resolution = call.setting<int>("resolution"), repeats = call.setting<int>("repeats");
-    const nlohmann::json what = {{"probe", "vct-structures"}, {"scene", name}, {"resolution", resolution}, {"repeats", repeats}};
-    return measured_once(call, what, [&] {
-        ProbeOutput out;
-        const Scene* scene = nullptr;
-        try {
-            scene = &scene_named(call, name);
-        } catch (const Error& e) {
-            out.notes.push_back(skip_note(call.ctx, name, e.what()));
-            return out;
-        }
-        const SceneFigures sf = measure_structures(call.ctx, *scene, resolution, repeats);
-        for (const std::string& s : kStructures) {
-            const StructureFigures& f = sf.by_structure.at(s);
-            out.rows.push_back({{"scene", sf.scene},
-                                {"resolution", resolution},
-                                {"structure", s},
-                                {"voxels", f.voxels},
-                                {"occupied", f.occupied},
-                                {"ms", f.ms},
-                                {"encoded_bytes", f.encoded_bytes},
-                                {"structure_bytes", f.structure_bytes},
-                                {"ms_conservative", number_or_null(f.ms_conservative)},
-                                {"ms_fragment", number_or_null(f.ms_fragment)}});
-        }
-        return out;
-    });
+    ProbeOutput out;
+    const Scene* scene = scene_or_skip(call, name, out);
+    if (!scene) return out;
+    const SceneFigures sf = measure_structures(call.ctx, *scene, resolution, repeats);
+    for (const std::string& s : kStructures) {
+        const StructureFigures& f = sf.by_structure.at(s);
+        out.rows.push_back({{"scene", sf.scene},
+                            {"resolution", resolution},
+                            {"structure", s},
+                            {"voxels", f.voxels},
+                            {"occupied", f.occupied},
+                            {"ms", f.ms},
+                            {"encoded_bytes", f.encoded_bytes},
+                            {"structure_bytes", f.structure_bytes},
+                            {"ms_conservative", number_or_null(f.ms_conservative)},
+                            {"ms_fragment", number_or_null(f.ms_fragment)}});
+    }
+    return out;
 }
 
 std::string model_of(const std::string& scene_name) {
@@ -395,16 +389,15 @@ ExperimentOutput structure_table(const SpecReduction& r, Quantity q) {
     for (const nlohmann::json& row : all_rows(r)) t.rows.push_back(table_row(row, q));
     out.tables.push_back(std::move(t));
     if (q == Quantity::VoxelizationTime) out.tables.push_back(speedup_table(r));
-    if (r.ctx.quick)
-        out.notes.push_back("Quick run: half the paper's resolutions (only bunny among the static models); paper "
-                            "columns are filled where the resolution matches.");
+    out.notes = quick_notes(r, {});
+    if (r.ctx.quick) out.notes.push_back("Paper columns are filled where the scene and resolution match the paper's.");
     return out;
 }
 
 // The paper's two scene sets: the Stanford models in the Cornell box (its static scenes,
 // Tables 1, 3, 5), fitted to half the box's width, and Sponza and Sibenik (its dynamic
 // scenes, static here: Tables 2, 4, 6). Quick runs take half the paper's resolutions and
-// only the bunny; times are the median of 3 runs (1 in quick runs).
+// only the bunny; times are the median of 3 repeats (1 in quick runs).
 const char* kModelsSet = "Cornell box + Stanford models";
 const char* kSponzaSet = "Sponza and Sibenik";
 const SpecAxis kModels = {"scene", {"cornell+bunny", "cornell+dragon", "cornell+buddha"}, {"cornell+bunny"}};

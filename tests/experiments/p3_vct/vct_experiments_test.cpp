@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 #include <set>
+#include <sstream>
 #include <string>
 #include "core/util/error.hpp"
 #include "experiments/runner/experiment.hpp"
@@ -192,31 +193,151 @@ ExperimentOutput run_quick(const std::string& name, uint64_t seed, const AssetPa
     return run_and_write(vct_registry().get(name), ctx);
 }
 
-double photon_map_mb(const ExperimentOutput& fig10, const std::string& scene) {
-    for (const json& row : fig10.tables.back().rows)
-        if (row.at("scene") == scene && row.at("variant") == "photon mapping")
-            return row.at("mean structure (MB)").get<double>();
-    ADD_FAILURE() << "no photon mapping row for " << scene;
+ExperimentContext quick_context(const std::string& dir, uint64_t seed = 1) {
+    ExperimentContext ctx;
+    ctx.quick = true;
+    ctx.seed = seed;
+    ctx.assets = AssetPaths::from_environment();
+    ctx.output_dir = test::temp_dir(dir);
+    return ctx;
+}
+
+int occurrences(const std::string& text, const std::string& what) {
+    int n = 0;
+    for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + what.size())) ++n;
+    return n;
+}
+
+// The plan's task `id` of `experiment` walking Sponza with photon mapping (the cheapest
+// walk), by its scene and variant.
+int sponza_photon_task(const Experiment& experiment) {
+    for (const SpecTask& t : plan_tasks(*experiment.spec, true))
+        if (t.scene == "sponza" && t.variants.at(0).name == "photon mapping") return t.id;
+    ADD_FAILURE() << experiment.name << " has no photon walk through sponza";
     return 0;
 }
 
-// The structure tables keep their measurements for the process (Tables 1, 3, 5 share one
-// run); a second run whose scene files are not there must not print the first run's.
+// A run whose scene files are not there has nothing to measure and says so; it must not
+// print an earlier run's figures.
 TEST_F(VctExperiments, ASecondRunWithOtherAssetsDoesNotReturnTheFirstRunsFigures) {
     (void)run_quick("vct-table1", 1, AssetPaths::from_environment());
     const AssetPaths empty({test::temp_dir("vct_cache_no_assets")});
     EXPECT_THROW((void)run_quick("vct-table1", 1, empty), Error);
 }
 
-// The walks of Figs. 9–10 are kept for the process too; the photon map holds the photons
-// a seed stores, so a second seed must give that seed's memory, the same seed the same.
+// Every run measures its own figures, also in one process with the same context: Table 1
+// run twice and Table 3 once measure the structures three times, and the photon walk of
+// Figs. 9 and 10 is walked once per run. The probes log each measurement.
+TEST_F(VctExperiments, EveryRunMeasuresItsOwnFigures) {
+    std::ostringstream log;
+    for (const char* name : {"vct-table1", "vct-table1", "vct-table3"}) {
+        ExperimentContext ctx = quick_context(std::string("vct_each_run_") + name);
+        ctx.log = &log;
+        (void)run_and_write(vct_registry().get(name), ctx);
+    }
+    EXPECT_EQ(occurrences(log.str(), "cornell+bunny 64³:"), 3) << log.str();
+    EXPECT_EQ(occurrences(log.str(), "cornell+bunny 128³:"), 3) << log.str();
+
+    std::ostringstream walks;
+    for (const char* name : {"vct-fig9", "vct-fig9", "vct-fig10"}) {
+        const Experiment& e = vct_registry().get(name);
+        ExperimentContext ctx = quick_context(std::string("vct_each_walk_") + name);
+        ctx.log = &walks;
+        (void)run_spec_task(*e.spec, sponza_photon_task(e), ctx);
+    }
+    EXPECT_EQ(occurrences(walks.str(), "sponza, photon mapping: mean frame"), 3) << walks.str();
+}
+
+// The photon map holds the photons a seed stores: another seed gives another memory, the
+// same seed the same.
 TEST_F(VctExperiments, ASecondRunWithAnotherSeedGivesItsOwnFigures) {
-    const AssetPaths assets = AssetPaths::from_environment();
-    const double first = photon_map_mb(run_quick("vct-fig10", 11, assets), "sponza");
-    const double second = photon_map_mb(run_quick("vct-fig10", 12, assets), "sponza");
-    const double first_again = photon_map_mb(run_quick("vct-fig10", 11, assets), "sponza");
+    const Experiment& fig10 = vct_registry().get("vct-fig10");
+    auto photon_bytes = [&](uint64_t seed) {
+        const json result = run_spec_task(*fig10.spec, sponza_photon_task(fig10),
+                                          quick_context("vct_seed_" + std::to_string(seed), seed));
+        return result.at("rows").at(0).at("bytes").get<std::vector<double>>();
+    };
+    const std::vector<double> first = photon_bytes(11), second = photon_bytes(12), first_again = photon_bytes(11);
     EXPECT_NE(first, second);
     EXPECT_EQ(first, first_again);
+}
+
+// Merging some of the walks: the cells of the variants whose tasks have not run are
+// empty, nothing is divided by another variant's figures, and a note lists what is
+// missing.
+TEST_F(VctExperiments, APartialMergeOfTheWalksLeavesTheMissingCellsEmpty) {
+    for (const char* name : {"vct-fig9", "vct-fig10"}) {
+        const Experiment& e = vct_registry().get(name);
+        const ExperimentContext ctx = quick_context(std::string("vct_partial_") + name);
+        (void)run_spec_task(*e.spec, sponza_photon_task(e), ctx);
+        const ExperimentOutput out = merge_spec_tasks(*e.spec, ctx);
+        SCOPED_TRACE(name);
+        ASSERT_EQ(out.tables.size(), 2u);  // the sponza walk and the summary
+        const ResultTable& walk = out.tables.at(0);
+        ASSERT_EQ(walk.rows.size(), 4u);  // the quick frames
+        const bool fig9 = std::string(name) == "vct-fig9";
+        for (const json& row : walk.rows) {
+            EXPECT_TRUE(row.at(fig9 ? "dense mip ms" : "dense mip (MB)").is_null()) << row.dump();
+            EXPECT_TRUE(row.at(fig9 ? "photon mapping ms" : "photon mapping (MB)").is_number()) << row.dump();
+        }
+        int rows = 0;
+        for (const json& row : out.tables.at(1).rows) {
+            ASSERT_EQ(row.at("scene"), "sponza") << row.dump();
+            const json& measured = row.at(fig9 ? "frame_ms" : "mean structure (MB)");
+            if (row.at("variant") == "photon mapping") {
+                EXPECT_TRUE(measured.is_number()) << row.dump();
+            } else if (row.at("variant") != "update time: everything ÷ strategy") {
+                EXPECT_TRUE(measured.is_null()) << row.dump();
+            }
+            if (fig9) {
+                if (row.at("variant") == "update time: everything ÷ strategy") {
+                    EXPECT_TRUE(row.at("update_ms").is_null()) << row.dump();
+                }
+            } else {
+                EXPECT_TRUE(row.at("over_dense").is_null()) << row.dump();  // no dense walk to divide by
+            }
+            ++rows;
+        }
+        EXPECT_EQ(rows, fig9 ? 5 : 4);
+        bool incomplete = false, absent = false;
+        for (const std::string& note : out.notes) {
+            incomplete |= note.starts_with("Incomplete: 7 of 8 tasks have not run");
+            absent |= note.starts_with("sponza: no walk for 'dense mip', 'cascaded, update everything', "
+                                       "'cascaded, update strategy' (task not merged)");
+        }
+        EXPECT_TRUE(incomplete);
+        EXPECT_TRUE(absent);
+    }
+}
+
+}  // namespace
+
+namespace {
+
+using namespace gilab;
+
+// The flicker walk is laid down Sponza's nave: a flicker variant naming another scene is
+// an error naming the setting, not a walk through the wrong building.
+TEST(VctFlicker, AnotherSceneIsAnErrorNamingTheSetting) {
+    (void)vct_registry();  // registers the probes
+    ExperimentSpec spec;
+    spec.name = "flicker-elsewhere";
+    spec.scenes = {"sibenik walk"};
+    spec.variants = {{.name = "cascaded",
+                      .probe = "vct-flicker",
+                      .settings = {{"scene", "sibenik"},
+                                   {"vct", nlohmann::json::object()},
+                                   {"walk_size", 8},
+                                   {"walk_frames", 2}}}};
+    ExperimentContext ctx;
+    ctx.quick = true;
+    ctx.output_dir = test::temp_dir("vct_flicker_elsewhere");
+    try {
+        (void)run_spec_task(spec, 0, ctx);
+        ADD_FAILURE() << "a flicker walk through sibenik ran";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("setting 'scene' is 'sibenik'"), std::string::npos) << e.what();
+    }
 }
 
 }  // namespace
