@@ -53,6 +53,18 @@ void require_no_slurm_options(const SweepCommand& c) {
                              "--dry-run go with --on slurm only");
 }
 
+// status, resume and merge work on a sweep as it was started: its record holds the
+// experiments, sizes, seed, results and Slurm options.
+void require_no_sweep_options(const SweepCommand& c) {
+    const SweepCommand defaults;
+    SlurmSweepOptions slurm = c.slurm;
+    slurm.dry_run = false;
+    if (c.quick != defaults.quick || c.results != defaults.results || c.seed != defaults.seed || c.on != defaults.on ||
+        slurm.to_json() != defaults.slurm.to_json())
+        throw Error("sweep " + c.arguments[0], "takes the sweep's own options from its sweep.json; give only the folder "
+                                               "(and --jobs or --dry-run for resume)");
+}
+
 fs::path sweep_folder(const SweepCommand& c) {
     if (c.arguments.size() != 2)
         throw Error("sweep " + c.arguments[0], "needs one folder: gilab sweep " + c.arguments[0] + " RESULTS/.sweep");
@@ -137,6 +149,7 @@ int resume(Sweep sweep, const SweepCommand& c, std::ostream& out, std::ostream& 
 int run_sweep_command(const SweepCommand& c, std::ostream& out, std::ostream& err) {
     const std::string& verb = c.arguments.at(0);
     if (verb == "status" || verb == "resume" || verb == "merge") {
+        require_no_sweep_options(c);
         const Sweep sweep = load_sweep(sweep_folder(c));
         if (verb == "status") return show_status(sweep, out);
         if (verb == "merge") return merge_sweep(sweep, out, err) == 0 ? 0 : 1;

@@ -147,10 +147,13 @@ TEST(SweepLocalBadInput, ErrorsNameTheProblemAndExitNonZero) {
         {{"sweep", "core-rays", "--on", "cloud"}, "cloud"},
         {{"sweep", "status", results.string()}, "no sweep here"},
         {{"sweep", "status"}, "needs one folder"},
+        {{"sweep", "resume", results.string(), "--quick"}, "takes the sweep's own options"},
+        {{"sweep", "merge", results.string(), "--on", "slurm"}, "takes the sweep's own options"},
     };
     for (const auto& [args, message] : cases) {
         std::vector<std::string> with_results = args;
-        with_results.insert(with_results.end(), {"--results", results.string()});
+        if (args[1] != "status" && args[1] != "resume" && args[1] != "merge")
+            with_results.insert(with_results.end(), {"--results", results.string()});
         const GilabRun run = run_gilab(with_results);
         EXPECT_NE(run.exit_code, 0) << run.output;
         EXPECT_TRUE(contains(run.output, message)) << "expected '" << message << "' in: " << run.output;
