@@ -1,10 +1,7 @@
 #include "experiments/sweep/sweep_command.hpp"
 
-#include <unistd.h>
-
 #include <map>
 #include "core/util/error.hpp"
-#include "experiments/sweep/program_call.hpp"
 
 namespace gilab {
 
@@ -45,10 +42,7 @@ fs::path this_program() {
 }
 
 void require_no_slurm_options(const SweepCommand& c) {
-    const SlurmSweepOptions defaults;
-    if (c.slurm.batch != defaults.batch || !c.slurm.partition.empty() || !c.slurm.time.empty() || !c.slurm.mem.empty() ||
-        c.slurm.throttle != defaults.throttle || c.slurm.cpus_per_task != defaults.cpus_per_task ||
-        !c.slurm.sbatch_args.empty() || c.slurm.dry_run)
+    if (c.slurm.to_json() != SlurmSweepOptions().to_json() || c.slurm.dry_run)
         throw Error("sweep", "--batch, --partition, --time, --mem, --throttle, --cpus-per-task, --sbatch-arg and "
                              "--dry-run go with --on slurm only");
 }
