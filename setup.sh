@@ -20,6 +20,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libnanoflann-dev
   gnuplot-nox chromium
   python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
+  # the single-node Slurm that the sweep_slurm test starts (scripts/slurm_local.sh)
+  slurm-wlm munge
 )
 missing=()
 for p in "${packages[@]}"; do

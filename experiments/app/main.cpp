@@ -1,4 +1,4 @@
-// The gilab command line: render, info, list, compare, experiment, report.
+// The gilab command line: render, info, list, compare, experiment, sweep, report.
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <sstream>
@@ -11,6 +11,7 @@
 #include "experiments/runner/experiment.hpp"
 #include "experiments/runner/experiment_batch.hpp"
 #include "experiments/runner/task_command.hpp"
+#include "experiments/sweep/sweep_command.hpp"
 #include "experiments/report/html_report.hpp"
 #include "experiments/app/render_command.hpp"
 #include "scenes/builtin_scenes.hpp"
@@ -194,6 +195,9 @@ int main(int argc, char** argv) {
     compare->add_option("--results", compare_request.results, "results root directory")->capture_default_str();
     compare->add_option("--seed", seed, "random seed")->capture_default_str();
 
+    SweepCommand sweep_command;
+    auto* sweep = add_sweep_subcommand(app, sweep_command);
+
     std::string report_dir = "results";
     auto* report = app.add_subcommand("report", "gather every results/NAME/results.json into results/report.html and "
                                                 "print a summary of the comparisons (frame time, relMSE, FLIP)");
@@ -240,6 +244,10 @@ int main(int argc, char** argv) {
             compare_request.assets = assets;
             const std::string folder = run_compare(compare_request);
             std::cout << "wrote " << folder << "/index.html\n";
+        } else if (*sweep) {
+            sweep_command.assets = assets_flag;
+            sweep_command.threads = threads;
+            return run_sweep_command(sweep_command, std::cout, std::cerr);
         } else if (*report) {
             int n = write_html_report(report_dir);
             std::cout << comparison_summary(report_dir);

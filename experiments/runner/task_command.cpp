@@ -1,6 +1,7 @@
 #include "experiments/runner/task_command.hpp"
 
 #include <charconv>
+#include <cstdlib>
 #include "core/util/error.hpp"
 #include "experiments/runner/experiment.hpp"
 #include "experiments/runner/spec_runner.hpp"
@@ -56,6 +57,9 @@ int run_task_command(const TaskCommand& c, std::ostream& out) {
     }
     if (c.verb == "run-task") {
         const int id = task_id(c.arguments[1]);
+        // For tests of failure handling (sweeps, job arrays): a task that fails on demand.
+        if (const char* fail = std::getenv("GILAB_FAIL_TASK"); fail && std::string(fail) == e.name + "/" + std::to_string(id))
+            throw Error(e.name + " task " + std::to_string(id), "failed on purpose ($GILAB_FAIL_TASK=" + std::string(fail) + ")");
         run_spec_task(*e.spec, id, ctx);
         out << "wrote " << spec_task_file(ctx.output_dir, id, ctx.quick).string() << "\n";
         return 0;

@@ -28,7 +28,8 @@ const Experiment& declared_experiment_named(const std::string& name);
 // plan: one JSON line per task (id, scene, axes, variants with technique or probe and
 // settings; seconds_last_run when RESULTS/NAME/tasks holds this task's result, as a
 // cost estimate).
-// run-task: runs task ID and writes RESULTS/NAME/tasks/{full|quick}/ID.json.
+// run-task: runs task ID and writes RESULTS/NAME/tasks/{full|quick}/ID.json; with
+// $GILAB_FAIL_TASK=NAME/ID it fails instead, writing nothing (tests of failed tasks).
 // merge: writes RESULTS/NAME/results.csv, results.json and table.md from the tasks there.
 // Returns the exit code; errors (an experiment that is not declared as a spec, a bad id)
 // are thrown as Error.

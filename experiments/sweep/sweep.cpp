@@ -1,0 +1,148 @@
+#include "experiments/sweep/sweep.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include "core/image/image_io.hpp"
+#include "core/util/error.hpp"
+#include "experiments/report/html_report.hpp"
+#include "experiments/runner/experiment.hpp"
+#include "experiments/runner/experiment_batch.hpp"
+#include "experiments/runner/spec_runner.hpp"
+#include "experiments/runner/task_command.hpp"
+
+namespace gilab {
+
+namespace fs = std::filesystem;
+
+nlohmann::json Sweep::to_json() const {
+    return {{"experiments", experiments}, {"quick", quick},     {"seed", seed},
+            {"results", results_root.string()}, {"assets", assets}, {"gilab", gilab.string()},
+            {"on", on},                   {"slurm", slurm},     {"submissions", submissions}};
+}
+
+Sweep Sweep::from_json(const nlohmann::json& j) {
+    Sweep s;
+    s.experiments = j.at("experiments").get<std::vector<std::string>>();
+    s.quick = j.at("quick").get<bool>();
+    s.seed = j.at("seed").get<uint64_t>();
+    s.results_root = j.at("results").get<std::string>();
+    s.assets = j.at("assets").get<std::string>();
+    s.gilab = j.at("gilab").get<std::string>();
+    s.on = j.at("on").get<std::string>();
+    s.slurm = j.at("slurm");
+    s.submissions = j.at("submissions");
+    return s;
+}
+
+std::vector<std::string> sweep_experiment_names(const std::vector<std::string>& names) {
+    if (names.empty()) throw Error("sweep", "needs experiment names or `all` (see `gilab experiment list`)");
+    std::vector<std::string> out;
+    auto add = [&out](const std::string& name) {
+        if (std::find(out.begin(), out.end(), name) == out.end()) out.push_back(name);
+    };
+    for (const std::string& name : names) {
+        if (name == "all") {
+            for (const Experiment& e : ExperimentRegistry::builtin().list())
+                if (e.spec) add(e.name);
+        } else {
+            add(declared_experiment_named(name).name);  // throws naming an unknown or undeclared one
+        }
+    }
+    return out;
+}
+
+std::vector<SweepTask> sweep_tasks(const Sweep& sweep) {
+    std::vector<SweepTask> tasks;
+    for (const std::string& name : sweep.experiments)
+        for (const SpecTask& t : plan_tasks(*declared_experiment_named(name).spec, sweep.quick))
+            tasks.push_back({name, t.id});
+    return tasks;
+}
+
+fs::path task_result_file(const Sweep& sweep, const SweepTask& task) {
+    return spec_task_file(sweep.results_root / task.experiment, task.id, sweep.quick);
+}
+
+bool task_done(const Sweep& sweep, const SweepTask& task) { return fs::exists(task_result_file(sweep, task)); }
+
+std::vector<SweepTask> tasks_without_result(const Sweep& sweep) {
+    std::vector<SweepTask> pending;
+    for (const SweepTask& t : sweep_tasks(sweep))
+        if (!task_done(sweep, t)) pending.push_back(t);
+    return pending;
+}
+
+std::vector<std::string> run_task_arguments(const Sweep& sweep, const SweepTask& task) {
+    std::vector<std::string> args = {"experiment", "run-task", task.experiment, std::to_string(task.id)};
+    if (sweep.quick) args.push_back("--quick");
+    args.insert(args.end(), {"--seed", std::to_string(sweep.seed), "--results", sweep.results_root.string()});
+    return args;
+}
+
+void save_sweep(const Sweep& sweep) {
+    fs::create_directories(sweep.directory());
+    write_file_atomically(sweep.directory() / "sweep.json", sweep.to_json().dump(2) + "\n");
+}
+
+Sweep load_sweep(const fs::path& sweep_dir) {
+    const fs::path file = sweep_dir / "sweep.json";
+    std::ifstream in(file);
+    if (!in)
+        throw Error(file.string(), "no sweep here: `gilab sweep` writes RESULTS/.sweep/sweep.json; give that folder");
+    try {
+        return Sweep::from_json(nlohmann::json::parse(in));
+    } catch (const nlohmann::json::exception& e) {
+        throw Error(file.string(), std::string("not a sweep record: ") + e.what());
+    }
+}
+
+namespace {
+
+void merge_published(const Sweep& sweep, const Experiment& e, std::ostream& out) {
+    const fs::path final_dir = sweep.results_root / e.name;
+    const fs::path tasks = spec_task_file(final_dir, 0, sweep.quick).parent_path();
+    if (!fs::is_directory(tasks)) throw Error(e.name, "no task has a result yet (" + tasks.string() + " does not exist)");
+    const fs::path staging = staging_directory(sweep.results_root, e.name);
+    fs::remove_all(staging);
+    // Hard links: the staging copy costs no space, and the merge replaces files by rename,
+    // so the published folder is never written through a link.
+    fs::copy(final_dir, staging, fs::copy_options::recursive | fs::copy_options::create_hard_links);
+    ExperimentContext ctx;
+    ctx.quick = sweep.quick;
+    ctx.output_dir = staging;
+    ctx.assets = AssetPaths::from_environment(sweep.assets.empty() ? std::nullopt : std::optional(sweep.assets));
+    ctx.seed = sweep.seed;
+    Experiment merging = e;
+    merging.run = [&e](const ExperimentContext& context) { return merge_spec_tasks(*e.spec, context); };
+    try {
+        const ExperimentOutput output = run_and_write(merging, ctx);
+        publish_directory(staging, final_dir);
+        const auto missing = output.config["effective"].value("tasks_missing", nlohmann::json::array());
+        out << "merged " << e.name << ": " << (final_dir / "table.md").string();
+        if (!missing.empty()) out << " (tasks missing: " << missing.dump() << ")";
+        out << std::endl;
+    } catch (...) {
+        std::error_code ec;
+        fs::remove_all(staging, ec);
+        throw;
+    }
+}
+
+}  // namespace
+
+int merge_sweep(const Sweep& sweep, std::ostream& out, std::ostream& err) {
+    int failures = 0;
+    for (const std::string& name : sweep.experiments) {
+        try {
+            merge_published(sweep, declared_experiment_named(name), out);
+        } catch (const Error& e) {
+            err << "gilab: sweep: cannot merge " << name << ": " << e.what() << std::endl;
+            ++failures;
+        }
+    }
+    const int pages = write_html_report(sweep.results_root);
+    out << "wrote " << (sweep.results_root / "report.html").string() << " (" << pages << " experiments)" << std::endl;
+    return failures;
+}
+
+}  // namespace gilab

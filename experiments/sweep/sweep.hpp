@@ -1,0 +1,64 @@
+#pragma once
+// A sweep: the tasks of several declared experiments (experiment_spec.hpp), run as
+// separate `gilab experiment run-task` processes — here (sweep_local.hpp) or as a Slurm
+// job array (sweep_slurm.hpp) — and merged into each experiment's tables afterwards.
+// A task is done when its result file exists (run-task writes it atomically), so a sweep
+// is resumed by running what has no result. The sweep's record, RESULTS/.sweep/sweep.json,
+// lets `gilab sweep status | resume | merge DIR` pick it up later, on another machine too.
+#include <cstdint>
+#include <filesystem>
+#include <ostream>
+#include <string>
+#include <vector>
+#include <nlohmann/json.hpp>
+
+namespace gilab {
+
+struct SweepTask {
+    std::string experiment;
+    int id = 0;  // in the experiment's plan
+};
+
+struct Sweep {
+    std::vector<std::string> experiments;  // declared experiments, in the order given
+    bool quick = false;
+    uint64_t seed = 1;
+    std::filesystem::path results_root;    // absolute: the tasks may run elsewhere
+    std::string assets;                    // --assets as given; "" = $GILAB_ASSETS where a task runs
+    std::filesystem::path gilab;           // the program each task runs (absolute)
+    std::string on = "local";              // local | slurm
+    nlohmann::json slurm = nlohmann::json::object();        // the Slurm options (sweep_slurm.hpp)
+    nlohmann::json submissions = nlohmann::json::array();   // one object per submitted round
+
+    std::filesystem::path directory() const { return results_root / ".sweep"; }
+    nlohmann::json to_json() const;
+    static Sweep from_json(const nlohmann::json& j);
+};
+
+// The declared experiments named (`all`: every declared one), checked: an unknown name or
+// one not declared as a spec is an Error naming it. Duplicates are dropped.
+std::vector<std::string> sweep_experiment_names(const std::vector<std::string>& names);
+
+// Every task of every experiment of the sweep, experiment by experiment in plan order.
+std::vector<SweepTask> sweep_tasks(const Sweep& sweep);
+
+// The task's result file, and whether it is there.
+std::filesystem::path task_result_file(const Sweep& sweep, const SweepTask& task);
+bool task_done(const Sweep& sweep, const SweepTask& task);
+std::vector<SweepTask> tasks_without_result(const Sweep& sweep);
+
+// The arguments after `gilab [--assets A]` that run the task:
+// experiment run-task NAME ID [--quick] --seed S --results DIR.
+std::vector<std::string> run_task_arguments(const Sweep& sweep, const SweepTask& task);
+
+// Writes and reads DIR/sweep.json (atomically); reading names the file on a bad one.
+void save_sweep(const Sweep& sweep);
+Sweep load_sweep(const std::filesystem::path& sweep_dir);
+
+// Merges each experiment's task files into its tables, as `gilab experiment merge` does,
+// but into a staging copy (hard links) published in one rename, so RESULTS/NAME always
+// holds a whole merge. Missing tasks are listed in the tables' notes. Returns the number
+// of experiments that could not be merged (each said on `err`), then writes the report.
+int merge_sweep(const Sweep& sweep, std::ostream& out, std::ostream& err);
+
+}  // namespace gilab
