@@ -152,8 +152,10 @@ int main(int argc, char** argv) {
     auto* experiment = app.add_subcommand(
         "experiment", "run experiments: `list`, a name, several names, or `all`; for a declared experiment also "
                       "`plan NAME` (its tasks as JSON lines), `run-task NAME ID` (one task, written to "
-                      "RESULTS/NAME/tasks/{full|quick}/ID.json) and `merge NAME` (the tables from the tasks that exist)");
-    experiment->add_option("names", experiment_names, "experiment names, `all`, `list`, or plan|run-task|merge NAME [ID]")
+                      "RESULTS/NAME/tasks/{full|quick}/ID.json), `references NAME ID` (the path-traced references the task "
+                      "compares against, rendered into RESULTS/.references) and `merge NAME` (the tables from the "
+                      "tasks that exist)");
+    experiment->add_option("names", experiment_names, "experiment names, `all`, `list`, or plan|run-task|references|merge NAME [ID]")
         ->required();
     experiment->add_flag("--quick", quick, "small sizes (smoke run, minutes)");
     experiment->add_option("--results", results_dir, "results root directory")->capture_default_str();
@@ -175,7 +177,7 @@ int main(int argc, char** argv) {
     compare->add_option("-W,--width", compare_request.width, "image (per-eye) width")->capture_default_str();
     compare->add_option("-H,--height", compare_request.height, "image (per-eye) height")->capture_default_str();
     compare->add_option("--reference-spp", compare_request.reference_spp,
-                        "samples per pixel of the path-traced reference (cached in RESULTS/compare/reference_cache)")
+                        "samples per pixel of the path-traced reference (cached in RESULTS/compare/.references)")
         ->capture_default_str();
     compare->add_option("--frames", compare_request.frames, "renders per technique; the median time is reported")
         ->capture_default_str();
@@ -259,7 +261,7 @@ int main(int argc, char** argv) {
                 return 0;
             }
             const std::string& verb = experiment_names[0];
-            if (verb == "plan" || verb == "run-task" || verb == "merge") {
+            if (verb == "plan" || verb == "run-task" || verb == "references" || verb == "merge") {
                 TaskCommand command;
                 command.verb = verb;
                 command.arguments.assign(experiment_names.begin() + 1, experiment_names.end());

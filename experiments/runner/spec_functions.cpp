@@ -36,9 +36,11 @@ int SpecReduction::reference_spp() const { return ctx.quick ? spec.quick_referen
 
 // Registering the same name again replaces it: each registry built from the same
 // register_* functions (the builtin one, a test's) adds the same functions.
-void add_probe(const std::string& name, ProbeFunction probe) {
+void add_probe(const std::string& name, ProbeFunction probe, ProbeReferences references) {
     std::lock_guard lock(registry_mutex());
     named<ProbeFunction>()[name] = std::move(probe);
+    if (references) named<ProbeReferences>()[name] = std::move(references);
+    else named<ProbeReferences>().erase(name);
 }
 void add_reducer(const std::string& name, ReducerFunction reducer) {
     std::lock_guard lock(registry_mutex());
@@ -48,6 +50,11 @@ const ProbeFunction* find_probe(const std::string& name) {
     std::lock_guard lock(registry_mutex());
     auto it = named<ProbeFunction>().find(name);
     return it == named<ProbeFunction>().end() ? nullptr : &it->second;
+}
+const ProbeReferences* find_probe_references(const std::string& name) {
+    std::lock_guard lock(registry_mutex());
+    auto it = named<ProbeReferences>().find(name);
+    return it == named<ProbeReferences>().end() ? nullptr : &it->second;
 }
 const ReducerFunction* find_reducer(const std::string& name) {
     std::lock_guard lock(registry_mutex());

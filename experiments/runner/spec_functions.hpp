@@ -14,6 +14,7 @@
 #include "core/util/error.hpp"
 #include "experiments/runner/experiment.hpp"
 #include "experiments/runner/experiment_spec.hpp"
+#include "experiments/runner/path_reference.hpp"
 
 namespace gilab {
 
@@ -60,6 +61,11 @@ struct ProbeOutput {
     std::vector<std::string> notes, files;
 };
 using ProbeFunction = std::function<ProbeOutput(const ProbeCall&)>;
+// The path-traced references a probe's task compares against (none for a missing scene).
+// A sweep renders them first, as tasks of their own (`gilab experiment references`), so
+// the tasks that share one find it in the store; the probe gets its references from the
+// same function, so the two cannot differ.
+using ProbeReferences = std::function<std::vector<ReferenceView>(const ProbeCall&)>;
 
 // One task's merged result.
 struct TaskResult {
@@ -86,9 +92,10 @@ struct SpecReduction {
 // Tables, notes, plots and files from the reduction; the runner adds the config.
 using ReducerFunction = std::function<ExperimentOutput(const SpecReduction&)>;
 
-void add_probe(const std::string& name, ProbeFunction probe);
+void add_probe(const std::string& name, ProbeFunction probe, ProbeReferences references = {});
 void add_reducer(const std::string& name, ReducerFunction reducer);
 const ProbeFunction* find_probe(const std::string& name);
+const ProbeReferences* find_probe_references(const std::string& name);  // null: the probe needs none
 const ReducerFunction* find_reducer(const std::string& name);
 
 template <class T>

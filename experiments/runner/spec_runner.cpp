@@ -34,6 +34,37 @@ EyeCamera spec_camera(const Scene& scene, int size) {
     return EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, size, size);
 }
 
+// The reference the relMSE measures of a task's technique variants compare against.
+ReferenceView technique_reference(const ExperimentSpec& spec, const Scene& scene, bool quick) {
+    return {&scene, spec_camera(scene, size_of(spec, quick)), reference_spp_of(spec, quick)};
+}
+
+bool measures_relmse(const ExperimentSpec& spec, const SpecTask& task) {
+    const bool technique = std::any_of(task.variants.begin(), task.variants.end(),
+                                       [](const TaskVariant& v) { return v.probe.empty(); });
+    return technique && std::any_of(spec.measures.begin(), spec.measures.end(),
+                                    [](const SpecMeasure& m) { return m.source == Source::RelMse; });
+}
+
+// The task's scene, loaded once per run (the cache), or nothing with `problem` said.
+const Scene* task_scene(const SpecTask& task, TaskCache& cache, const ExperimentContext& ctx, std::string& problem) {
+    try {
+        return &cache.get<Scene>("scene:" + task.scene, [&] { return open_scene(task.scene, ctx.assets).scene; });
+    } catch (const Error& e) {
+        problem = "Scene '" + task.scene + "' skipped: " + std::string(e.what());
+        return nullptr;
+    }
+}
+
+const SpecTask& planned_task(const std::vector<SpecTask>& tasks, const ExperimentSpec& spec, int task_id, bool quick) {
+    if (task_id < 0 || task_id >= int(tasks.size()))
+        throw Error(spec.name, "no task " + std::to_string(task_id) + " in the " + (quick ? "quick " : "") +
+                                   "plan (tasks 0 to " + std::to_string(tasks.size() - 1) +
+                                   "; `gilab experiment plan " + spec.name + (quick ? " --quick" : "") +
+                                   "` lists them)");
+    return tasks[size_t(task_id)];
+}
+
 // What identifies a task's work: a result file must match it to be merged. The sizes
 // and measures come from the spec, so a spec changed since the task ran is caught.
 nlohmann::json task_identity(const ExperimentSpec& spec, const SpecTask& t, bool quick, uint64_t seed) {
@@ -139,8 +170,7 @@ std::vector<nlohmann::json> run_technique_variants(const ExperimentSpec& spec, c
                 case Source::LayerMean: row[m.column] = mean_value(film, m.key); break;
                 case Source::ImageDigest: row[m.column] = layer_digest(film, m.key); break;
                 case Source::RelMse: {
-                    if (!reference)
-                        reference = path_reference(ctx, scene, camera, reference_spp_of(spec, ctx.quick), files);
+                    if (!reference) reference = path_reference(ctx, technique_reference(spec, scene, ctx.quick), files);
                     row[m.column] = relative_mse(film, *reference, m.key);
                     break;
                 }
@@ -170,12 +200,9 @@ nlohmann::json run_planned_task(const ExperimentSpec& spec, const SpecTask& task
     if (!techniques.empty()) {
         // A scene that cannot be loaded (a shared asset not installed) leaves the task
         // without rows and says why, as the probes do.
-        const Scene* scene = nullptr;
-        try {
-            scene = &cache.get<Scene>("scene:" + task.scene, [&] { return open_scene(task.scene, ctx.assets).scene; });
-        } catch (const Error& e) {
-            notes.push_back("Scene '" + task.scene + "' skipped: " + std::string(e.what()));
-        }
+        std::string problem;
+        const Scene* scene = task_scene(task, cache, ctx, problem);
+        if (!scene) notes.push_back(problem);
         std::vector<std::string> reference_files;
         if (scene)
             for (nlohmann::json& row : run_technique_variants(spec, task, techniques, *scene, ctx, per_frame, reference_files))
@@ -256,13 +283,38 @@ fs::path spec_task_file(const fs::path& output_dir, int task_id, bool quick) {
 
 nlohmann::json run_spec_task(const ExperimentSpec& spec, int task_id, const ExperimentContext& ctx) {
     const std::vector<SpecTask> tasks = plan_tasks(spec, ctx.quick);
-    if (task_id < 0 || task_id >= int(tasks.size()))
-        throw Error(spec.name, "no task " + std::to_string(task_id) + " in the " + (ctx.quick ? "quick " : "") +
-                                   "plan (tasks 0 to " + std::to_string(tasks.size() - 1) +
-                                   "; `gilab experiment plan " + spec.name + (ctx.quick ? " --quick" : "") +
-                                   "` lists them)");
     TaskCache cache;
-    return run_planned_task(spec, tasks[size_t(task_id)], cache, ctx);
+    return run_planned_task(spec, planned_task(tasks, spec, task_id, ctx.quick), cache, ctx);
+}
+
+std::string reference_group(const ExperimentSpec& spec, const SpecTask& task, bool quick) {
+    for (const TaskVariant& v : task.variants)
+        if (!v.probe.empty() && find_probe_references(v.probe)) return spec.name + "/" + std::to_string(task.id);
+    if (!measures_relmse(spec, task)) return "";
+    return task.scene + " " + std::to_string(size_of(spec, quick)) + "px " + std::to_string(reference_spp_of(spec, quick)) +
+           "spp";
+}
+
+int render_task_references(const ExperimentSpec& spec, int task_id, const ExperimentContext& ctx) {
+    const std::vector<SpecTask> tasks = plan_tasks(spec, ctx.quick);
+    const SpecTask& task = planned_task(tasks, spec, task_id, ctx.quick);
+    TaskCache cache;
+    std::vector<std::string> files;
+    if (measures_relmse(spec, task)) {
+        std::string problem;
+        if (const Scene* scene = task_scene(task, cache, ctx, problem))
+            path_reference(ctx, technique_reference(spec, *scene, ctx.quick), files);
+        else
+            ctx.say(problem);
+    }
+    for (const TaskVariant& v : task.variants) {
+        const ProbeReferences* references = v.probe.empty() ? nullptr : find_probe_references(v.probe);
+        if (!references) continue;
+        const ProbeCall call{spec, task, v, ctx, size_of(spec, ctx.quick), frames_of(spec, ctx.quick),
+                             reference_spp_of(spec, ctx.quick), cache};
+        for (const ReferenceView& view : (*references)(call)) path_reference(ctx, view, files);
+    }
+    return int(files.size());
 }
 
 ExperimentOutput merge_spec_tasks(const ExperimentSpec& spec, const ExperimentContext& ctx) {

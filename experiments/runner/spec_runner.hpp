@@ -21,6 +21,17 @@ std::filesystem::path spec_task_file(const std::filesystem::path& output_dir, in
 // file; returns the result. Throws Error naming the task for an id outside the plan.
 nlohmann::json run_spec_task(const ExperimentSpec& spec, int task_id, const ExperimentContext& ctx);
 
+// The path-traced references task `task_id` compares against (its technique variants'
+// relMSE, its probes' references), rendered into the results folder's store
+// (path_reference.hpp) unless there already; returns how many. A sweep runs this before
+// the tasks, once per reference group, so tasks that share references do not wait for
+// each other or render them twice.
+int render_task_references(const ExperimentSpec& spec, int task_id, const ExperimentContext& ctx);
+
+// Tasks with the same group need the same references ("" = the task needs none): the
+// technique variants' scene, size and samples, or NAME/ID for a probe's own references.
+std::string reference_group(const ExperimentSpec& spec, const SpecTask& task, bool quick);
+
 // Reduces the task files in ctx.output_dir/tasks into the experiment's tables. Refuses
 // a task file written for another plan (another --quick, --seed, spec or task order)
 // naming the file; tasks not run yet are listed in a note and in the config's

@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include "core/util/error.hpp"
 #include "experiments/runner/experiment.hpp"
+#include "experiments/runner/path_reference.hpp"
 #include "experiments/runner/spec_runner.hpp"
 
 namespace gilab {
@@ -35,10 +36,10 @@ int task_id(const std::string& text) {
 }  // namespace
 
 int run_task_command(const TaskCommand& c, std::ostream& out) {
-    const size_t wanted = c.verb == "run-task" ? 2 : 1;
-    if (c.arguments.size() != wanted)
-        throw Error(c.verb, c.verb == "run-task" ? "needs an experiment name and a task id: run-task NAME ID"
-                                                 : "needs one experiment name: " + c.verb + " NAME");
+    const bool one_task = c.verb == "run-task" || c.verb == "references";
+    if (c.arguments.size() != (one_task ? 2u : 1u))
+        throw Error(c.verb, one_task ? "needs an experiment name and a task id: " + c.verb + " NAME ID"
+                                     : "needs one experiment name: " + c.verb + " NAME");
     const Experiment& e = declared_experiment_named(c.arguments[0]);
     ExperimentContext ctx;
     ctx.quick = c.quick;
@@ -51,6 +52,7 @@ int run_task_command(const TaskCommand& c, std::ostream& out) {
         for (const SpecTask& t : plan_tasks(*e.spec, c.quick)) {
             nlohmann::json line = t.to_json();
             if (const auto seconds = last_task_seconds(*e.spec, t, ctx)) line["seconds_last_run"] = *seconds;
+            if (const std::string group = reference_group(*e.spec, t, c.quick); !group.empty()) line["references"] = group;
             out << line.dump() << "\n";
         }
         return 0;
@@ -62,6 +64,11 @@ int run_task_command(const TaskCommand& c, std::ostream& out) {
             throw Error(e.name + " task " + std::to_string(id), "failed on purpose ($GILAB_FAIL_TASK=" + std::string(fail) + ")");
         run_spec_task(*e.spec, id, ctx);
         out << "wrote " << spec_task_file(ctx.output_dir, id, ctx.quick).string() << "\n";
+        return 0;
+    }
+    if (c.verb == "references") {
+        const int count = render_task_references(*e.spec, task_id(c.arguments[1]), ctx);
+        out << count << " reference(s) of task " << c.arguments[1] << " in " << reference_store(ctx).string() << "\n";
         return 0;
     }
     const fs::path tasks = spec_task_file(ctx.output_dir, 0, ctx.quick).parent_path();

@@ -11,7 +11,7 @@
 namespace gilab {
 
 struct TaskCommand {
-    std::string verb;                     // plan | run-task | merge
+    std::string verb;                     // plan | run-task | references | merge
     std::vector<std::string> arguments;   // NAME [ID]
     std::filesystem::path results_root = "results";
     bool quick = false;
@@ -27,9 +27,12 @@ const Experiment& declared_experiment_named(const std::string& name);
 
 // plan: one JSON line per task (id, scene, axes, variants with technique or probe and
 // settings; seconds_last_run when RESULTS/NAME/tasks holds this task's result, as a
-// cost estimate).
+// cost estimate; `references`, the task's reference group, when it compares against
+// path-traced references).
 // run-task: runs task ID and writes RESULTS/NAME/tasks/{full|quick}/ID.json; with
 // $GILAB_FAIL_TASK=NAME/ID it fails instead, writing nothing (tests of failed tasks).
+// references: renders the path-traced references task ID needs into RESULTS/.references
+// (those there already are kept), so the tasks that need them find them.
 // merge: writes RESULTS/NAME/results.csv, results.json and table.md from the tasks there.
 // Returns the exit code; errors (an experiment that is not declared as a spec, a bad id)
 // are thrown as Error.
