@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <fstream>
+#include <map>
+#include <set>
 #include "core/image/image_io.hpp"
 #include "core/util/error.hpp"
 #include "experiments/report/html_report.hpp"
@@ -72,11 +74,37 @@ std::vector<SweepTask> tasks_without_result(const Sweep& sweep) {
     return pending;
 }
 
-std::vector<std::string> run_task_arguments(const Sweep& sweep, const SweepTask& task) {
-    std::vector<std::string> args = {"experiment", "run-task", task.experiment, std::to_string(task.id)};
+namespace {
+
+std::vector<std::string> experiment_arguments(const Sweep& sweep, const std::string& verb, const SweepTask& task) {
+    std::vector<std::string> args = {"experiment", verb, task.experiment, std::to_string(task.id)};
     if (sweep.quick) args.push_back("--quick");
     args.insert(args.end(), {"--seed", std::to_string(sweep.seed), "--results", sweep.results_root.string()});
     return args;
+}
+
+}  // namespace
+
+std::vector<std::string> run_task_arguments(const Sweep& sweep, const SweepTask& task) {
+    return experiment_arguments(sweep, "run-task", task);
+}
+
+std::vector<std::string> references_arguments(const Sweep& sweep, const SweepTask& task) {
+    return experiment_arguments(sweep, "references", task);
+}
+
+std::vector<SweepTask> reference_tasks(const Sweep& sweep, const std::vector<SweepTask>& tasks) {
+    std::set<std::string> groups;
+    std::vector<SweepTask> out;
+    std::map<std::string, std::vector<SpecTask>> plans;
+    for (const SweepTask& t : tasks) {
+        const ExperimentSpec& spec = *declared_experiment_named(t.experiment).spec;
+        auto plan = plans.find(t.experiment);
+        if (plan == plans.end()) plan = plans.emplace(t.experiment, plan_tasks(spec, sweep.quick)).first;
+        const std::string group = reference_group(spec, plan->second.at(size_t(t.id)), sweep.quick);
+        if (!group.empty() && groups.insert(group).second) out.push_back(t);
+    }
+    return out;
 }
 
 void save_sweep(const Sweep& sweep) {

@@ -51,6 +51,14 @@ std::vector<SweepTask> tasks_without_result(const Sweep& sweep);
 // experiment run-task NAME ID [--quick] --seed S --results DIR.
 std::vector<std::string> run_task_arguments(const Sweep& sweep, const SweepTask& task);
 
+// Path-traced references (experiments/runner/path_reference.hpp) are rendered before the
+// tasks, as tasks of their own: one per reference group (spec_runner.hpp) among `tasks`,
+// the first task of each group standing for it. Their arguments are those of
+// `gilab experiment references NAME ID …`, which renders the task's references into
+// RESULTS/.references; a task whose references are there only reads them.
+std::vector<SweepTask> reference_tasks(const Sweep& sweep, const std::vector<SweepTask>& tasks);
+std::vector<std::string> references_arguments(const Sweep& sweep, const SweepTask& task);
+
 // Writes and reads DIR/sweep.json (atomically); reading names the file on a bad one.
 void save_sweep(const Sweep& sweep);
 Sweep load_sweep(const std::filesystem::path& sweep_dir);

@@ -2,7 +2,9 @@
 // `gilab sweep --on local`: the sweep's tasks run here, each as its own
 // `gilab experiment run-task` process (so a crash or a kill loses one task, never a
 // result file), up to `jobs` at a time; tasks whose result file exists are skipped, so
-// running the same command again resumes. Then each experiment is merged (merge_sweep).
+// running the same command again resumes. The path-traced references the tasks share go
+// first, one `gilab experiment references` process per reference group (sweep.hpp).
+// Then each experiment is merged (merge_sweep).
 #include <filesystem>
 #include <ostream>
 #include "experiments/sweep/sweep.hpp"

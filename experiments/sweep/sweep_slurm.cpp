@@ -41,7 +41,9 @@ void require_one_word(const std::string& text, const std::string& what) {
 
 std::string quoted(const std::string& text) { return "'" + text + "'"; }
 
-fs::path tasks_file(const Sweep& sweep, int round) { return sweep.directory() / ("tasks." + std::to_string(round) + ".txt"); }
+fs::path list_file(const Sweep& sweep, int round, ArrayKind kind) {
+    return sweep.directory() / ((kind == ArrayKind::References ? "references." : "tasks.") + std::to_string(round) + ".txt");
+}
 
 std::string gilab_call(const Sweep& sweep) {
     std::string call = quoted(sweep.gilab.string());
@@ -123,37 +125,42 @@ std::string task_key(const SweepTask& task) { return task.experiment + " " + std
 std::string task_list_text(const Sweep& sweep, const std::vector<SweepTask>& tasks) {
     std::string text;
     for (const SweepTask& t : tasks) {
-        const std::vector<std::string> args = run_task_arguments(sweep, t);
+        const std::vector<std::string> args = run_task_arguments(sweep, t);  // the same as `references` takes
         for (size_t i = 2; i < args.size(); ++i) text += args[i] + (i + 1 < args.size() ? " " : "\n");
     }
     return text;
 }
 
-std::string array_script(const Sweep& sweep, const SlurmSweepOptions& o, size_t task_count, int round) {
+std::string array_script(const Sweep& sweep, const SlurmSweepOptions& o, size_t task_count, int round, ArrayKind kind) {
     const size_t indices = (task_count + size_t(o.batch) - 1) / size_t(o.batch);
     const std::string r = std::to_string(round);
+    const bool references = kind == ArrayKind::References;
+    const std::string verb = references ? "references" : "run-task";
     std::ostringstream s;
     s << "#!/bin/bash\n"
-      << "# gilab sweep, round " << r << ": " << task_count << " task(s) in " << indices << " array index(es). Index i\n"
+      << "# gilab sweep, round " << r << ": " << task_count << (references ? " reference group(s)" : " task(s)") << " in "
+      << indices << " array index(es). Index i\n"
       << "# runs lines i*" << o.batch << "+1 to i*" << o.batch << "+" << o.batch
-      << " of the task list, each as `gilab experiment run-task`, which\n"
-      << "# writes its result file whole or not at all.\n"
-      << "#SBATCH --job-name=gilab-sweep\n"
+      << " of the list, each as `gilab experiment " << verb << "`, which\n"
+      << (references ? "# renders the task's path-traced references into the store, each whole or not at all.\n"
+                     : "# writes its result file whole or not at all.\n")
+      << "#SBATCH --job-name=gilab-sweep" << (references ? "-references" : "") << "\n"
       << "#SBATCH --array=0-" << indices - 1 << (o.throttle > 0 ? "%" + std::to_string(o.throttle) : "") << "\n"
-      << "#SBATCH --output=" << (sweep.directory() / "logs").string() << "/array." << r << "_%a.out\n"
+      << "#SBATCH --output=" << (sweep.directory() / "logs").string() << "/" << (references ? "references." : "array.")
+      << r << "_%a.out\n"
       << "#SBATCH --cpus-per-task=" << o.cpus_per_task << "\n";
     if (!o.time.empty()) s << "#SBATCH --time=" << slurm_time_minutes(o.time) * o.batch << "\n";
     if (!o.mem.empty()) s << "#SBATCH --mem=" << o.mem << "\n";
     common_directives(s, o);
     s << "set -u\n"
-      << "tasks=" << quoted(tasks_file(sweep, round).string()) << "\n"
+      << "tasks=" << quoted(list_file(sweep, round, kind).string()) << "\n"
       << "first=$(( SLURM_ARRAY_TASK_ID * " << o.batch << " + 1 ))\n"
       << "last=$(( first + " << o.batch - 1 << " ))\n"
       << "failed=0\n"
       << "while read -r -a task; do\n"
-      << "    echo \"gilab sweep: experiment run-task ${task[*]}\"\n"
-      << "    " << gilab_call(sweep) << " --threads " << o.cpus_per_task
-      << " experiment run-task \"${task[@]}\" </dev/null || failed=1\n"
+      << "    echo \"gilab sweep: experiment " << verb << " ${task[*]}\"\n"
+      << "    " << gilab_call(sweep) << " --threads " << o.cpus_per_task << " experiment " << verb
+      << " \"${task[@]}\" </dev/null || failed=1\n"
       << "done < <(sed -n \"${first},${last}p\" \"$tasks\")\n"
       << "exit $failed\n";
     return s.str();
@@ -186,39 +193,71 @@ void submit_sweep_round(Sweep& sweep, const std::vector<SweepTask>& tasks, const
     const int round = int(sweep.submissions.size()) + 1;
     const std::string r = std::to_string(round);
     fs::create_directories(sweep.directory() / "logs");
+    const std::vector<SweepTask> references = reference_tasks(sweep, tasks);
+    const fs::path references_file = sweep.directory() / ("references." + r + ".sbatch");
     const fs::path array_file = sweep.directory() / ("array." + r + ".sbatch");
     const fs::path merge_file = sweep.directory() / ("merge." + r + ".sbatch");
-    write_file_atomically(tasks_file(sweep, round), task_list_text(sweep, tasks));
-    write_file_atomically(array_file, array_script(sweep, options, tasks.size(), round));
+    if (!references.empty()) {
+        write_file_atomically(list_file(sweep, round, ArrayKind::References), task_list_text(sweep, references));
+        write_file_atomically(references_file,
+                              array_script(sweep, options, references.size(), round, ArrayKind::References));
+    }
+    write_file_atomically(list_file(sweep, round, ArrayKind::Tasks), task_list_text(sweep, tasks));
+    write_file_atomically(array_file, array_script(sweep, options, tasks.size(), round, ArrayKind::Tasks));
     write_file_atomically(merge_file, merge_script(sweep, options, round));
     nlohmann::json record = {{"round", round},
-                             {"tasks_file", tasks_file(sweep, round).string()},
+                             {"tasks_file", list_file(sweep, round, ArrayKind::Tasks).string()},
                              {"tasks", tasks.size()},
+                             {"reference_groups", references.size()},
                              {"batch", options.batch},
+                             {"references_job", ""},
                              {"array_job", ""},
                              {"merge_job", ""}};
     sweep.slurm = options.to_json();
-    out << "wrote " << tasks_file(sweep, round).string() << " (" << tasks.size() << " tasks), " << array_file.string()
-        << " and " << merge_file.string() << std::endl;
+    out << "wrote " << list_file(sweep, round, ArrayKind::Tasks).string() << " (" << tasks.size() << " tasks), "
+        << array_file.string() << " and " << merge_file.string();
+    if (!references.empty())
+        out << ", and " << references_file.string() << " (" << references.size()
+            << " reference group(s), rendered before the tasks)";
+    out << std::endl;
     if (options.dry_run) {
         sweep.submissions.push_back(record);
         save_sweep(sweep);
-        out << "dry run: nothing submitted; submit with\n  sbatch --parsable " << array_file.string()
-            << "\n  sbatch --dependency=afterany:JOBID " << merge_file.string() << std::endl;
+        out << "dry run: nothing submitted; submit with\n";
+        if (!references.empty())
+            out << "  sbatch --parsable " << references_file.string() << "\n  sbatch --parsable --dependency=afterany:REFJOB "
+                << array_file.string() << "\n";
+        else
+            out << "  sbatch --parsable " << array_file.string() << "\n";
+        out << "  sbatch --dependency=afterany:JOBID " << merge_file.string() << std::endl;
         return;
     }
-    const std::string array_job = submit({"sbatch", "--parsable", array_file.string()});
-    record["array_job"] = array_job;
+    // Each job is recorded as soon as it is in Slurm's hands, before anything else can fail.
+    std::vector<std::string> array_args = {"sbatch", "--parsable"};
+    if (!references.empty()) {
+        record["references_job"] = submit({"sbatch", "--parsable", references_file.string()});
+        // afterany: a reference that could not be rendered is rendered by its tasks.
+        array_args.push_back("--dependency=afterany:" + record["references_job"].get<std::string>());
+    }
     sweep.submissions.push_back(record);
-    save_sweep(sweep);  // the array is in Slurm's hands now: record it before anything else can fail
+    save_sweep(sweep);
+    array_args.push_back(array_file.string());
+    const std::string array_job = submit(array_args);
+    sweep.submissions.back()["array_job"] = array_job;
+    save_sweep(sweep);
     const std::string merge_job =
         submit({"sbatch", "--parsable", "--dependency=afterany:" + array_job, merge_file.string()});
     sweep.submissions.back()["merge_job"] = merge_job;
     save_sweep(sweep);
+    const std::string references_job = record["references_job"];
+    const std::string all_jobs = (references_job.empty() ? "" : references_job + ",") + array_job + "," + merge_job;
+    if (!references_job.empty())
+        out << "submitted references job " << references_job << " (" << (references.size() + size_t(options.batch) - 1) / size_t(options.batch)
+            << " indices), then\n";
     out << "submitted array job " << array_job << " (" << (tasks.size() + size_t(options.batch) - 1) / size_t(options.batch)
         << " indices) and merge job " << merge_job << " (after the array)\n"
-        << "watch:   squeue -j " << array_job << "," << merge_job << "\n"
-        << "account: sacct -j " << array_job << "," << merge_job << "   (where accounting is on)\n"
+        << "watch:   squeue -j " << all_jobs << "\n"
+        << "account: sacct -j " << all_jobs << "   (where accounting is on)\n"
         << "status:  gilab sweep status " << sweep.directory().string() << "\n"
         << "logs:    " << (sweep.directory() / "logs").string() << std::endl;
 }
@@ -253,7 +292,7 @@ SlurmTaskStates query_slurm_states(const Sweep& sweep) {
     SlurmTaskStates result;
     std::string jobs;
     for (const nlohmann::json& s : sweep.submissions)
-        for (const char* key : {"array_job", "merge_job"})
+        for (const char* key : {"references_job", "array_job", "merge_job"})
             if (!s.value(key, std::string()).empty()) jobs += (jobs.empty() ? "" : ",") + s.value(key, std::string());
     if (jobs.empty()) return result;
     std::map<std::string, std::string> queued, accounted;

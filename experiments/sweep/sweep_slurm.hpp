@@ -9,6 +9,10 @@
 //                   fails exits non-zero (Slurm records it failed), its other tasks still run
 //   merge.R.sbatch  `gilab sweep merge DIR` (tables and report), submitted with
 //                   --dependency=afterany on the array so it runs however the tasks end
+//   references.R.txt, references.R.sbatch
+//                   when tasks compare against path-traced references: a job array
+//                   before the tasks' (which depends on it, afterany) rendering each
+//                   reference group's references once into RESULTS/.references
 // and submits both with `sbatch --parsable`. Scheduling, retries (`scontrol requeue`),
 // dependencies and accounting are Slurm's: gilab writes files and reads squeue/sacct.
 #include <filesystem>
@@ -41,9 +45,12 @@ struct SlurmSweepOptions {
 // Error naming the text when it is none of these.
 long slurm_time_minutes(const std::string& text);
 
-// The files' contents, for round `round` of `tasks`.
+// The files' contents, for round `round` of `tasks`: the job array of the tasks, or the
+// one before it that renders the reference groups' references (sweep.hpp).
+enum class ArrayKind { Tasks, References };
 std::string task_list_text(const Sweep& sweep, const std::vector<SweepTask>& tasks);
-std::string array_script(const Sweep& sweep, const SlurmSweepOptions& options, size_t task_count, int round);
+std::string array_script(const Sweep& sweep, const SlurmSweepOptions& options, size_t task_count, int round,
+                         ArrayKind kind = ArrayKind::Tasks);
 std::string merge_script(const Sweep& sweep, const SlurmSweepOptions& options, int round);
 
 // Writes round R's files (R = submissions so far + 1) for `tasks` and, unless dry_run,

@@ -96,6 +96,19 @@ TEST_F(SweepLocal, GivesTheTablesOfGilabExperimentAndSkipsDoneTasksWhenRunAgain)
     const GilabRun swept = run_gilab(sweep_args(results));
     ASSERT_EQ(swept.exit_code, 0) << swept.output;
     EXPECT_TRUE(contains(swept.output, "[7/7] ")) << swept.output;
+    // pm-radius-sweep's four tasks share one reference, rendered once before them into
+    // the store; each task then reads it from there.
+    EXPECT_TRUE(contains(swept.output, "references first: 1 reference group(s)")) << swept.output;
+    size_t stored = 0;
+    for (const auto& entry : fs::directory_iterator(results / ".references"))
+        stored += entry.path().extension() == ".exr";
+    EXPECT_EQ(stored, 1u);
+    for (int id = 0; id < 4; ++id) {
+        std::ifstream log(results / ".sweep" / "logs" / ("pm-radius-sweep." + std::to_string(id) + ".log"));
+        const std::string text{std::istreambuf_iterator<char>(log), std::istreambuf_iterator<char>()};
+        EXPECT_TRUE(contains(text, "reference from the store")) << text;
+        EXPECT_FALSE(contains(text, "rendering the path-traced reference")) << text;
+    }
     for (const std::string& name : kExperiments) {
         EXPECT_EQ(tables_without_timings(results / name), tables_without_timings(reference / name)) << name;
         EXPECT_TRUE(read_json(results / name / "results.json")["config"]["effective"]["tasks_missing"].empty()) << name;

@@ -74,6 +74,18 @@ TEST(SweepSlurmFiles, DryRunWritesOneTaskLinePerTaskAndOneArrayIndexPerTask) {
     EXPECT_TRUE(contains(array, "tasks='" + (dir / "tasks.1.txt").string() + "'")) << array;
     EXPECT_TRUE(contains(array, "first=$(( SLURM_ARRAY_TASK_ID * 1 + 1 ))")) << array;
 
+    // pm-radius-sweep's four tasks share one reference (scene, size, samples): one line,
+    // rendered by an array of its own before the tasks'; core-rays needs none.
+    const std::vector<std::string> references = lines_of(read_text(dir / "references.1.txt"));
+    ASSERT_EQ(references.size(), 1u);
+    EXPECT_EQ(references[0], "pm-radius-sweep 0 --quick --seed 7 --results " + results);
+    const std::string reference_array = read_text(dir / "references.1.sbatch");
+    EXPECT_TRUE(contains(reference_array, "#SBATCH --array=0-0%2\n")) << reference_array;
+    EXPECT_TRUE(contains(reference_array, "#SBATCH --job-name=gilab-sweep-references\n")) << reference_array;
+    EXPECT_TRUE(contains(reference_array, "experiment references \"${task[@]}\"")) << reference_array;
+    EXPECT_TRUE(contains(reference_array, "tasks='" + (dir / "references.1.txt").string() + "'")) << reference_array;
+    EXPECT_TRUE(contains(out.str(), "--dependency=afterany:REFJOB " + (dir / "array.1.sbatch").string())) << out.str();
+
     const std::string merge = read_text(dir / "merge.1.sbatch");
     EXPECT_TRUE(contains(merge, "'/opt/gilab/bin/gilab' sweep merge '" + dir.string() + "'")) << merge;
     EXPECT_TRUE(contains(merge, "#SBATCH --partition=short\n")) << merge;
@@ -120,8 +132,16 @@ TEST(SweepSlurmFiles, ASecondRoundHoldsOnlyTheTasksGivenIt) {
     EXPECT_EQ(lines_of(read_text(sweep.directory() / "tasks.2.txt")),
               std::vector<std::string>{"pm-radius-sweep 2 --quick --seed 7 --results " + sweep.results_root.string()});
     EXPECT_TRUE(contains(read_text(sweep.directory() / "array.2.sbatch"), "--array=0-0\n"));
+    // The task stands for its reference group in this round.
+    EXPECT_EQ(lines_of(read_text(sweep.directory() / "references.2.txt")),
+              std::vector<std::string>{"pm-radius-sweep 2 --quick --seed 7 --results " + sweep.results_root.string()});
     EXPECT_EQ(load_sweep(sweep.directory()).submissions.size(), 2u);
     EXPECT_TRUE(fs::exists(sweep.directory() / "tasks.1.txt"));
+    // A round of tasks that need no reference has no references array.
+    submit_sweep_round(sweep, {SweepTask{"core-rays", 1}}, options, out);
+    EXPECT_FALSE(fs::exists(sweep.directory() / "references.3.txt"));
+    EXPECT_FALSE(fs::exists(sweep.directory() / "references.3.sbatch"));
+    EXPECT_EQ(load_sweep(sweep.directory()).submissions[2]["reference_groups"], 0);
 }
 
 TEST(SweepSlurmFiles, SlurmTimesAreReadInEveryFormatSbatchTakes) {
