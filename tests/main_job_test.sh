@@ -3,10 +3,13 @@
 # small sizes in an empty directory, then a second time over the results the first run
 # left, and fails when a step fails, the report is missing or the end of the output does
 # not give the comparisons' summary and the report's path.
-#   tests/main_job_test.sh GILAB SOURCE_DIR
+# With KEEP, the results are moved there afterwards: the local run the Slurm sweep test
+# compares against (every experiment at quick size, run by `gilab experiment all`).
+#   tests/main_job_test.sh GILAB SOURCE_DIR [KEEP]
 set -euo pipefail
 gilab="$1"
 source_dir="$2"
+keep="${3:-}"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 cd "$work"
@@ -39,4 +42,9 @@ for run in first second; do
     fi
   done
 done
+if [ -n "$keep" ]; then
+  rm -rf "$keep"
+  mkdir -p "$(dirname "$keep")"
+  mv "$work/results" "$keep"
+fi
 echo "main job: both runs ended with the report and the summary"

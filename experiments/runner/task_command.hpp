@@ -29,8 +29,9 @@ const Experiment& declared_experiment_named(const std::string& name);
 // settings; seconds_last_run when RESULTS/NAME/tasks holds this task's result, as a
 // cost estimate; `references`, the task's reference group, when it compares against
 // path-traced references).
-// run-task: runs task ID and writes RESULTS/NAME/tasks/{full|quick}/ID.json; with
-// $GILAB_FAIL_TASK=NAME/ID it fails instead, writing nothing (tests of failed tasks).
+// run-task: runs task ID and writes RESULTS/NAME/tasks/{full|quick}/ID.json. For tests
+// of failed and killed tasks: with $GILAB_FAIL_TASK=NAME/ID it fails instead, writing
+// nothing; with $GILAB_TASK_DELAY=NAME/ID:SECONDS it waits that long first.
 // references: renders the path-traced references task ID needs into RESULTS/.references
 // (those there already are kept), so the tasks that need them find them.
 // merge: writes RESULTS/NAME/results.csv, results.json and table.md from the tasks there.
