@@ -60,15 +60,35 @@ struct NoisyReference {
 // The second half's seed: independent of the first half's and of the run's.
 uint64_t second_half_seed(uint64_t run_seed) { return reference_seed(run_seed) ^ 0x48414c46ull; }
 
-// Two path-traced references A and B on independent seeds (each cached like every
-// reference), averaged: R = (A + B) / 2. A pixel's error of R has variance σ²/2 where σ²
-// is one half's, and E[((A − B) / 2)²] = σ²/2 too, so the relMSE of R + (A − B) / 2
-// against R estimates the relMSE R's own noise adds to any error measured against it.
-NoisyReference noisy_reference(const ExperimentContext& ctx, const Scene& scene, const EyeCamera& camera,
-                               int spp_per_half) {
+// A task's reference halves A and B, jittered, at the scene camera and the run's size:
+// A on the reference's seed, B on second_half_seed. None when the scene cannot be loaded
+// (the probe notes the skip).
+std::vector<ReferenceView> point_references(const ProbeCall& call) {
+    const Scene* scene = nullptr;
+    try {
+        scene = &call.scene();
+    } catch (const Error&) {
+        return {};
+    }
+    if (!scene->camera) throw Error("pm-convergence", call.task.scene + " has no camera");
+    const SceneCamera& c = *scene->camera;
+    const EyeCamera camera = EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, call.size, call.size);
+    const int spp_per_half = call.setting<json>("reference_spp_per_half")
+                                 .at(call.ctx.quick ? "quick" : "full")
+                                 .at(call.task.scene)
+                                 .get<int>();
+    return {ReferenceView{scene, camera, spp_per_half, /*jitter=*/true},
+            ReferenceView{scene, camera, spp_per_half, /*jitter=*/true, second_half_seed(call.ctx.seed)}};
+}
+
+// The two halves A and B (point_references; each cached like every reference), averaged:
+// R = (A + B) / 2. A pixel's error of R has variance σ²/2 where σ² is one half's, and
+// E[((A − B) / 2)²] = σ²/2 too, so the relMSE of R + (A − B) / 2 against R estimates the
+// relMSE R's own noise adds to any error measured against it.
+NoisyReference noisy_reference(const ExperimentContext& ctx, const std::vector<ReferenceView>& halves) {
     NoisyReference r;
-    const Film a = path_reference(ctx, scene, camera, spp_per_half, r.files, /*jitter=*/true);
-    const Film b = path_reference(ctx, scene, camera, spp_per_half, r.files, /*jitter=*/true, second_half_seed(ctx.seed));
+    const Film a = path_reference(ctx, halves.at(0), r.files);
+    const Film b = path_reference(ctx, halves.at(1), r.files);
     Film mean(a.width(), a.height()), off_by_noise(a.width(), a.height());
     const auto& da = a.layer("color").data;
     const auto& db = b.layer("color").data;
@@ -105,16 +125,14 @@ ProbeOutput point_probe(const ProbeCall& call) {
         call.ctx.say("skipping " + call.task.scene + ": " + e.what());
         return out;
     }
-    if (!scene->camera) throw Error("pm-convergence", call.task.scene + " has no camera");
-    const SceneCamera& c = *scene->camera;
-    const EyeCamera camera = EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, call.size, call.size);
-    const int spp_per_half = call.setting<json>("reference_spp_per_half")
-                                 .at(call.ctx.quick ? "quick" : "full")
-                                 .at(call.task.scene)
-                                 .get<int>();
+    // The point is rendered with the reference's camera; the run's tasks share the
+    // reference (the cache), so only the first to need it reads or renders it.
+    const std::vector<ReferenceView> halves = point_references(call);
+    const EyeCamera& camera = halves.at(0).camera;
+    const int spp_per_half = halves.at(0).spp;
     const NoisyReference& ref = call.cache.get<NoisyReference>(
         "pm-convergence reference:" + call.task.scene + ":" + std::to_string(call.size) + ":" + std::to_string(spp_per_half),
-        [&] { return noisy_reference(call.ctx, *scene, camera, spp_per_half); });
+        [&] { return noisy_reference(call.ctx, halves); });
     out.files = ref.files;
 
     const std::string technique = call.setting<std::string>("technique");
@@ -304,7 +322,7 @@ std::vector<json> points(const Curves& c) {
 }  // namespace
 
 Experiment photon_convergence_experiment() {
-    add_probe("pm-convergence", point_probe);
+    add_probe("pm-convergence", point_probe, point_references);
     add_reducer("pm-convergence", reduce);
     return declared_experiment({
         .name = "pm-convergence",

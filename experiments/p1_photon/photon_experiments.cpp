@@ -328,12 +328,25 @@ std::vector<std::string> write_images(const ProbeCall& call, const std::string& 
     return files;
 }
 
+// The reference the images are compared with, at the scene camera (none when the scene
+// cannot be loaded; the probe then fails on loading it).
+std::vector<ReferenceView> fig8_references(const ProbeCall& call) {
+    const Scene* scene = nullptr;
+    try {
+        scene = &call.scene();
+    } catch (const Error&) {
+        return {};
+    }
+    return {ReferenceView{scene, scene_camera(*scene, call.size), call.reference_spp}};
+}
+
 // The probe's settings: photons, radius and the shared photon settings, and under
 // "compare" each image's name, file stem and own settings. The images are prepared in
 // turn and rendered in turn frame by frame, as the tables' variants are.
 ProbeOutput fig8_probe(const ProbeCall& call) {
     const Scene& scene = call.scene();
-    const EyeCamera camera = scene_camera(scene, call.size);
+    const ReferenceView view = fig8_references(call).at(0);
+    const EyeCamera& camera = view.camera;
     json shared = call.variant.settings;
     const json compare = shared.at("compare");
     shared.erase("compare");
@@ -347,7 +360,7 @@ ProbeOutput fig8_probe(const ProbeCall& call) {
     const InterleavedRender rendered =
         render_interleaved(techniques, ViewSet::mono(camera), call.frames, {"render_ms"}, call.spec.slow);
     ProbeOutput out;
-    const Film reference = path_reference(call.ctx, scene, camera, call.reference_spp, out.files);
+    const Film reference = path_reference(call.ctx, view, out.files);
     const double reference_indirect = mean_value(reference, "indirect");
     for (size_t i = 0; i < techniques.size(); ++i) {
         const std::string stem = compare[i].at("image");
@@ -403,7 +416,7 @@ void register_photon_experiments(ExperimentRegistry& registry) {
     add_reducer("pm-table2", reduce_table2);
     add_reducer("pm-table3", reduce_table3);
     add_reducer("pm-table4", reduce_table4);
-    add_probe("pm-fig8", fig8_probe);
+    add_probe("pm-fig8", fig8_probe, fig8_references);
     add_reducer("pm-fig8", reduce_fig8);
 
     const auto photon = [](std::string name, json own) {

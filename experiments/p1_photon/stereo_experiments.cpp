@@ -39,15 +39,25 @@ int side_of(const json& photons) { return int(std::lround(std::sqrt(photons.get<
 std::string label_of(const std::string& scene) { return scene == "cornell" ? "cornell" : "conference (Office)"; }
 bool is_office(const std::string& scene) { return scene != "cornell"; }
 
-// The task's scene, or a note saying why it is skipped (a missing asset).
-const Scene* scene_or_note(const ProbeCall& call, ProbeOutput& out) {
+// The task's scene, or null with `why` when it cannot be loaded (a missing asset).
+const Scene* loaded_scene(const ProbeCall& call, std::string& why) {
     try {
         return &call.scene();
     } catch (const Error& e) {
-        out.notes.push_back(std::string("Office scene skipped: ") + e.what());
-        call.ctx.say(std::string("skipping ") + call.task.scene + ": " + e.what());
+        why = e.what();
         return nullptr;
     }
+}
+
+// The task's scene, or a note saying why it is skipped.
+const Scene* scene_or_note(const ProbeCall& call, ProbeOutput& out) {
+    std::string why;
+    const Scene* scene = loaded_scene(call, why);
+    if (!scene) {
+        out.notes.push_back("Office scene skipped: " + why);
+        call.ctx.say("skipping " + call.task.scene + ": " + why);
+    }
+    return scene;
 }
 
 // Per-eye resolution: the Vive's 1080×1200, a fifth of it per side in quick runs.
@@ -278,6 +288,14 @@ SpecAxis table5_axis() {
 // ---------------------------------------------------------------------------------
 // Final renders (Figs. 9–11: frame times of Figs. 9 and 10, layers of Fig. 11)
 
+// The final renders' reference: the left eye of the stereo pair (none without the scene).
+std::vector<ReferenceView> final_references(const ProbeCall& call) {
+    std::string why;
+    const Scene* scene = loaded_scene(call, why);
+    if (!scene) return {};
+    return {ReferenceView{scene, stereo_views(vive_rig(*scene, call.ctx.quick)).views[0], reference_spp_for(call)}};
+}
+
 ProbeOutput final_probe(const ProbeCall& call) {
     ProbeOutput out;
     const Scene* scene = scene_or_note(call, out);
@@ -288,8 +306,9 @@ ProbeOutput final_probe(const ProbeCall& call) {
     const double radius = paper.number("radius");
     const ViewSet views = stereo_views(vive_rig(*scene, call.ctx.quick));
     const Run run = measure(call, *scene, views, {photon_settings(call, kProbeKeys, {{"radius", radius}})})[0];
-    const int spp = reference_spp_for(call);
-    const Film reference = path_reference(call.ctx, *scene, views.views[0], spp, out.files);
+    const ReferenceView left = final_references(call).at(0);
+    const int spp = left.spp;
+    const Film reference = path_reference(call.ctx, left, out.files);
     json r = {{"scene", label_of(call.task.scene)},
               {"photons", squared(side_of(call.variant.settings.at("photons")))},
               {"r", radius},
@@ -333,17 +352,26 @@ ExperimentOutput reduce_final(const SpecReduction& r) {
 // ---------------------------------------------------------------------------------
 // Foveated gather
 
+// The left eye's reference (none without the scene); the probe renders that eye.
+std::vector<ReferenceView> foveated_references(const ProbeCall& call) {
+    std::string why;
+    const Scene* scene = loaded_scene(call, why);
+    if (!scene) return {};
+    return {ReferenceView{scene, vive_rig(*scene, call.ctx.quick).eye(Eye::Left), reference_spp_for(call)}};
+}
+
 ProbeOutput foveated_probe(const ProbeCall& call) {
     ProbeOutput out;
     const Scene* scene = scene_or_note(call, out);
     if (!scene) return out;
-    const EyeCamera eye = vive_rig(*scene, call.ctx.quick).eye(Eye::Left);
+    const ReferenceView view = foveated_references(call).at(0);
+    const EyeCamera& eye = view.camera;
     const std::vector<float> angles = call.setting<std::vector<float>>("fovea_angles");
     const json unfoveated = photon_settings(call, kProbeKeys);
     std::vector<json> variants = {unfoveated};
     for (float a : angles) variants.push_back(with(unfoveated, {{"foveated", true}, {"fovea_angle", a}}));
     const std::vector<Run> runs = measure(call, *scene, ViewSet::mono(eye), variants);
-    const Film reference = path_reference(call.ctx, *scene, eye, reference_spp_for(call), out.files);
+    const Film reference = path_reference(call.ctx, view, out.files);
     const double pixels = double(eye.width()) * double(eye.height());
     const Film& full = runs[0].films[0];
     auto row = [&](const Run& run, std::optional<float> angle) {
@@ -400,9 +428,9 @@ const json kReferenceSpp = {{"cornell", 256}, {"conference", 128}};
 void register_stereo_experiments(ExperimentRegistry& registry) {
     add_probe("pm-table5", table5_probe);
     add_reducer("pm-table5", reduce_table5);
-    add_probe("pm-final", final_probe);
+    add_probe("pm-final", final_probe, final_references);
     add_reducer("pm-final", reduce_final);
-    add_probe("pm-foveated", foveated_probe);
+    add_probe("pm-foveated", foveated_probe, foveated_references);
     add_reducer("pm-foveated", reduce_foveated);
 
     const std::vector<std::string> scenes = {"cornell", "conference"};

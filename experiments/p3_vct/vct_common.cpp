@@ -117,6 +117,14 @@ const Scene* scene_or_skip(const ProbeCall& call, const std::string& name, Probe
     }
 }
 
+const Scene* loadable_scene(const ProbeCall& call, const std::string& name) {
+    try {
+        return &scene_named(call, name);
+    } catch (const Error&) {
+        return nullptr;
+    }
+}
+
 std::string scene_of(const ProbeCall& call) { return call.setting<std::string>("scene", call.task.scene); }
 
 EyeCamera scene_camera(const Scene& scene, int size) {

@@ -25,6 +25,9 @@ const Scene& scene_named(const ProbeCall& call, const std::string& name);
 // The scene `name`, or null with a skip note (skip_note) added to `out` when it cannot be
 // loaded.
 const Scene* scene_or_skip(const ProbeCall& call, const std::string& name, ProbeOutput& out);
+// The scene `name`, or null without a note when it cannot be loaded: for a probe's
+// references, whose probe notes the skip itself.
+const Scene* loadable_scene(const ProbeCall& call, const std::string& name);
 
 // The probe's scene: its setting "scene", else the task's scene.
 std::string scene_of(const ProbeCall& call);

@@ -21,18 +21,32 @@ EyeCamera probe_camera(const ProbeCall& call, const Scene& scene) {
                               call.size);
 }
 
-// The path-traced reference of the task's scene and camera (max depth 8, its own seed),
-// rendered once per run, with the files it was written to.
+// The path-traced reference of the variant's scene and camera (max depth 8, its own
+// seed); none when the scene cannot be loaded (the probe notes the skip).
+std::vector<ReferenceView> image_reference(const ProbeCall& call) {
+    const Scene* scene = loadable_scene(call, scene_of(call));
+    if (!scene) return {};
+    return {ReferenceView{scene, probe_camera(call, *scene), call.reference_spp}};
+}
+
+// A vct-image variant's reference: only with setting "against_reference".
+std::vector<ReferenceView> vct_image_references(const ProbeCall& call) {
+    if (!call.setting<bool>("against_reference", false)) return {};
+    return image_reference(call);
+}
+
+// The reference of image_reference, rendered once per run (the task's variants share it),
+// with the files it was written to.
 struct Reference {
     Film film;
     std::vector<std::string> files;
 };
-const Reference& reference_of(const ProbeCall& call, const Scene& scene, const EyeCamera& camera) {
+const Reference& reference_of(const ProbeCall& call) {
     const std::string key = "vct reference:" + scene_of(call) + " " + std::to_string(call.size) + " " +
                             std::to_string(call.reference_spp);
     return call.cache.get<Reference>(key, [&] {
         Reference r;
-        r.film = path_reference(call.ctx, scene, camera, call.reference_spp, r.files);
+        r.film = path_reference(call.ctx, image_reference(call).at(0), r.files);
         return r;
     });
 }
@@ -43,7 +57,7 @@ ProbeOutput reference_image_probe(const ProbeCall& call) {
     ProbeOutput out;
     const Scene* scene = scene_or_skip(call, scene_of(call), out);
     if (!scene) return out;
-    const Reference& ref = reference_of(call, *scene, probe_camera(call, *scene));
+    const Reference& ref = reference_of(call);
     out.rows.push_back({{"image", call.variant.name}, {"relmse_color", 0.0}, {"relmse_indirect", 0.0},
                         {"mean_color", mean_value(ref.film)}, {"mean_indirect", mean_value(ref.film, "indirect")},
                         {"frame_ms", nullptr}});
@@ -69,7 +83,7 @@ ProbeOutput vct_image_probe(const ProbeCall& call) {
                           {"mean_specular", mean_value(f, "specular")},
                           {"frame_ms", tech->stats().get("total_ms")}};
     if (call.setting<bool>("against_reference", false)) {
-        const Reference& ref = reference_of(call, *scene, camera);
+        const Reference& ref = reference_of(call);
         row["relmse_color"] = relative_mse(f, ref.film, "color");
         row["relmse_indirect"] = relative_mse(f, ref.film, "indirect");
     }
@@ -108,8 +122,8 @@ nlohmann::json buddha(bool specular) {
 }  // namespace
 
 void register_images(ExperimentRegistry& registry) {
-    add_probe("vct-reference-image", reference_image_probe);
-    add_probe("vct-image", vct_image_probe);
+    add_probe("vct-reference-image", reference_image_probe, image_reference);
+    add_probe("vct-image", vct_image_probe, vct_image_references);
     add_reducer("vct-fig11", [](const SpecReduction& r) {
         return image_table(r, "Fig. 11 — Sponza: cone-traced images against a path-traced reference",
                            {"image", "relmse_color", "relmse_indirect", "mean_color", "mean_indirect", "frame_ms"},

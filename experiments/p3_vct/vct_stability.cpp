@@ -63,24 +63,42 @@ ProbeOutput flicker_probe(const ProbeCall& call) {
     return out;
 }
 
-// The thin-wall rooms seen from the dark room (the scene camera) and from the lit one, at
-// "leak_size": their mean radiance, path traced ("leak_reference_spp") when the variant
-// has no "vct" settings, else cone traced; setting "image_file" keeps the dark room's
-// image.
-ProbeOutput leak_probe(const ProbeCall& call) {
-    const Scene& rooms = scene_named(call, scene_of(call));
+// The leak probe's views of the thin-wall rooms at "leak_size": from the dark room (the
+// scene camera) and from the lit one.
+struct LeakCameras {
+    EyeCamera dark, lit;
+};
+LeakCameras leak_cameras(const ProbeCall& call, const Scene& rooms) {
     const int size = call.setting<int>("leak_size");
     const SceneCamera& c = *rooms.camera;
-    const EyeCamera dark_cam = EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, size, size);
-    const EyeCamera lit_cam =
-        EyeCamera::look_at(Vec3(0.2f, 0.5f, 0.5f), Vec3(2.0f, 0.35f, 0.5f), c.up, c.vertical_fov_degrees, size, size);
+    return {EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, size, size),
+            EyeCamera::look_at(Vec3(0.2f, 0.5f, 0.5f), Vec3(2.0f, 0.35f, 0.5f), c.up, c.vertical_fov_degrees, size, size)};
+}
+
+// The path-traced variant's references ("leak_reference_spp"): the dark room's view, then
+// the lit room's. None for a cone-traced variant (setting "vct") or without the scene.
+std::vector<ReferenceView> leak_references(const ProbeCall& call) {
+    if (call.variant.settings.contains("vct")) return {};
+    const Scene* rooms = loadable_scene(call, scene_of(call));
+    if (!rooms) return {};
+    const LeakCameras cams = leak_cameras(call, *rooms);
+    const int spp = call.setting<int>("leak_reference_spp");
+    return {ReferenceView{rooms, cams.dark, spp}, ReferenceView{rooms, cams.lit, spp}};
+}
+
+// The thin-wall rooms seen from the dark room and from the lit one: their mean radiance,
+// path traced (leak_references) when the variant has no "vct" settings, else cone
+// traced; setting "image_file" keeps the dark room's image.
+ProbeOutput leak_probe(const ProbeCall& call) {
+    const Scene& rooms = scene_named(call, scene_of(call));
     ProbeOutput out;
     Film dark, lit;
     if (!call.variant.settings.contains("vct")) {
-        const int spp = call.setting<int>("leak_reference_spp");
-        dark = path_reference(call.ctx, rooms, dark_cam, spp, out.files);
-        lit = path_reference(call.ctx, rooms, lit_cam, spp, out.files);
+        const std::vector<ReferenceView> views = leak_references(call);
+        dark = path_reference(call.ctx, views.at(0), out.files);
+        lit = path_reference(call.ctx, views.at(1), out.files);
     } else {
+        const auto [dark_cam, lit_cam] = leak_cameras(call, rooms);
         auto tech = make_vct(rooms, vct_settings(call), call.ctx);
         lit = render(*tech, lit_cam);
         dark = render(*tech, dark_cam);
@@ -135,7 +153,7 @@ nlohmann::json leak_vct(const std::string& structure, bool clip_plane) {
 
 void register_stability(ExperimentRegistry& registry) {
     add_probe("vct-flicker", flicker_probe);
-    add_probe("vct-leak", leak_probe);
+    add_probe("vct-leak", leak_probe, leak_references);
     add_reducer("vct-stability", stability);
     registry.add(declared_experiment({
         .name = "vct-stability",

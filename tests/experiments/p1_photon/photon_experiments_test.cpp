@@ -7,10 +7,14 @@
 #include <gtest/gtest.h>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <map>
+#include <set>
+#include <sstream>
 #include <string>
 #include <tuple>
 #include "experiments/runner/experiment.hpp"
+#include "experiments/runner/path_reference.hpp"
 #include "tests/experiment_test_support.hpp"
 
 namespace {
@@ -275,5 +279,58 @@ TEST(PhotonConvergence, TheReferenceIsAtMostATenthOfTheSmallestErrorReported) {
         EXPECT_LE(n, 0.1 * smallest[scene]) << scene;
     }
 }
+
+// A probe's references function names the references its task compares against:
+// rendered first (`gilab experiment references`), the task finds every one in the store,
+// renders none, and lists exactly the files rendered. pm-fig8 needs one reference at the
+// scene camera, pm-convergence two jittered halves on different seeds; the specs are
+// shrunk to 16² images and a few samples, on the Cornell box (built in).
+class PhotonProbeReferences : public testing::TestWithParam<const char*> {};
+
+ExperimentSpec small_spec(const std::string& name) {
+    ExperimentSpec spec = *photon_registry().get(name).spec;
+    spec.name += "-small";
+    spec.scenes = {"cornell"};
+    spec.quick_size = 16;
+    spec.quick_frames = 1;
+    spec.quick_reference_spp = 4;
+    if (name == "pm-fig8") spec.axes.at(0).quick = {json{{"photons", 32 * 32}, {"radius", 0.08}}};
+    if (name == "pm-convergence") spec.variants.at(0).settings["reference_spp_per_half"]["quick"]["cornell"] = 4;
+    return spec;
+}
+
+TEST_P(PhotonProbeReferences, TheTaskFindsTheReferencesRenderedForIt) {
+    namespace fs = std::filesystem;
+    const ExperimentSpec spec = small_spec(GetParam());
+    ExperimentContext ctx;
+    ctx.quick = true;
+    ctx.output_dir = test::temp_dir(std::string("probe_references_") + GetParam()) / spec.name;
+    ctx.assets = AssetPaths::from_environment();
+    std::ostringstream log;
+    ctx.log = &log;
+    const int rendered = render_task_references(spec, 0, ctx);
+    EXPECT_EQ(rendered, std::string(GetParam()) == "pm-convergence" ? 2 : 1);
+    std::set<std::string> stored;
+    for (const auto& entry : fs::directory_iterator(reference_store(ctx)))
+        if (entry.path().extension() == ".exr") stored.insert(entry.path().filename().string());
+    ASSERT_EQ(int(stored.size()), rendered) << log.str();
+
+    log.str("");
+    const json result = run_spec_task(spec, 0, ctx);
+    const std::string said = log.str();
+    EXPECT_EQ(said.find("rendering the path-traced reference"), std::string::npos) << said;
+    std::set<std::string> listed;
+    for (const json& file : result.at("files"))
+        if (file.get<std::string>().starts_with("reference_path_")) listed.insert(file.get<std::string>());
+    EXPECT_EQ(listed, stored);
+    size_t found = 0;
+    for (size_t at = said.find("reference from the store"); at != std::string::npos;
+         at = said.find("reference from the store", at + 1))
+        ++found;
+    EXPECT_EQ(found, stored.size()) << said;
+}
+
+INSTANTIATE_TEST_SUITE_P(Probes, PhotonProbeReferences, testing::Values("pm-fig8", "pm-convergence"),
+                         test::test_name_of);
 
 }  // namespace
