@@ -322,7 +322,11 @@ std::vector<json> points(const Curves& c) {
 }  // namespace
 
 Experiment photon_convergence_experiment() {
-    add_probe("pm-convergence", point_probe, point_references);
+    add_probe("pm-convergence", point_probe, point_references, [](const ProbeCall& call) {
+        const int spp = call.setting<json>("reference_spp_per_half").at(call.ctx.quick ? "quick" : "full").at(call.task.scene);
+        return "pm-convergence halves: " + call.task.scene + " " + std::to_string(call.size) + "px " +
+               std::to_string(spp) + "spp";
+    });
     add_reducer("pm-convergence", reduce);
     return declared_experiment({
         .name = "pm-convergence",

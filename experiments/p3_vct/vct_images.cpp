@@ -122,8 +122,15 @@ nlohmann::json buddha(bool specular) {
 }  // namespace
 
 void register_images(ExperimentRegistry& registry) {
-    add_probe("vct-reference-image", reference_image_probe, image_reference);
-    add_probe("vct-image", vct_image_probe, vct_image_references);
+    // The groups mirror reference_of's key: tasks of one scene, size and samples share it.
+    const auto image_group = [](const ProbeCall& call) {
+        return "vct reference: " + scene_of(call) + " " + std::to_string(call.size) + "px " +
+               std::to_string(call.reference_spp) + "spp";
+    };
+    add_probe("vct-reference-image", reference_image_probe, image_reference, image_group);
+    add_probe("vct-image", vct_image_probe, vct_image_references, [image_group](const ProbeCall& call) {
+        return call.setting<bool>("against_reference", false) ? image_group(call) : std::string();
+    });
     add_reducer("vct-fig11", [](const SpecReduction& r) {
         return image_table(r, "Fig. 11 — Sponza: cone-traced images against a path-traced reference",
                            {"image", "relmse_color", "relmse_indirect", "mean_color", "mean_indirect", "frame_ms"},

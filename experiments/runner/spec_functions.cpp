@@ -36,11 +36,13 @@ int SpecReduction::reference_spp() const { return ctx.quick ? spec.quick_referen
 
 // Registering the same name again replaces it: each registry built from the same
 // register_* functions (the builtin one, a test's) adds the same functions.
-void add_probe(const std::string& name, ProbeFunction probe, ProbeReferences references) {
+void add_probe(const std::string& name, ProbeFunction probe, ProbeReferences references, ProbeReferenceGroup group) {
     std::lock_guard lock(registry_mutex());
     named<ProbeFunction>()[name] = std::move(probe);
     if (references) named<ProbeReferences>()[name] = std::move(references);
     else named<ProbeReferences>().erase(name);
+    if (group) named<ProbeReferenceGroup>()[name] = std::move(group);
+    else named<ProbeReferenceGroup>().erase(name);
 }
 void add_reducer(const std::string& name, ReducerFunction reducer) {
     std::lock_guard lock(registry_mutex());
@@ -55,6 +57,11 @@ const ProbeReferences* find_probe_references(const std::string& name) {
     std::lock_guard lock(registry_mutex());
     auto it = named<ProbeReferences>().find(name);
     return it == named<ProbeReferences>().end() ? nullptr : &it->second;
+}
+const ProbeReferenceGroup* find_probe_reference_group(const std::string& name) {
+    std::lock_guard lock(registry_mutex());
+    auto it = named<ProbeReferenceGroup>().find(name);
+    return it == named<ProbeReferenceGroup>().end() ? nullptr : &it->second;
 }
 const ReducerFunction* find_reducer(const std::string& name) {
     std::lock_guard lock(registry_mutex());

@@ -66,6 +66,10 @@ using ProbeFunction = std::function<ProbeOutput(const ProbeCall&)>;
 // the tasks that share one find it in the store; the probe gets its references from the
 // same function, so the two cannot differ.
 using ProbeReferences = std::function<std::vector<ReferenceView>(const ProbeCall&)>;
+// Which tasks need the same references as this one, decided from the plan alone (the
+// call's scene is not loaded: only its task, variant, sizes and settings): tasks with
+// equal groups share them, "" needs none. Without one, each task is a group of its own.
+using ProbeReferenceGroup = std::function<std::string(const ProbeCall&)>;
 
 // One task's merged result.
 struct TaskResult {
@@ -92,10 +96,12 @@ struct SpecReduction {
 // Tables, notes, plots and files from the reduction; the runner adds the config.
 using ReducerFunction = std::function<ExperimentOutput(const SpecReduction&)>;
 
-void add_probe(const std::string& name, ProbeFunction probe, ProbeReferences references = {});
+void add_probe(const std::string& name, ProbeFunction probe, ProbeReferences references = {},
+               ProbeReferenceGroup group = {});
 void add_reducer(const std::string& name, ReducerFunction reducer);
 const ProbeFunction* find_probe(const std::string& name);
 const ProbeReferences* find_probe_references(const std::string& name);  // null: the probe needs none
+const ProbeReferenceGroup* find_probe_reference_group(const std::string& name);  // null: none given
 const ReducerFunction* find_reducer(const std::string& name);
 
 template <class T>

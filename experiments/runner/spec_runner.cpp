@@ -288,11 +288,24 @@ nlohmann::json run_spec_task(const ExperimentSpec& spec, int task_id, const Expe
 }
 
 std::string reference_group(const ExperimentSpec& spec, const SpecTask& task, bool quick) {
-    for (const TaskVariant& v : task.variants)
-        if (!v.probe.empty() && find_probe_references(v.probe)) return spec.name + "/" + std::to_string(task.id);
-    if (!measures_relmse(spec, task)) return "";
-    return task.scene + " " + std::to_string(size_of(spec, quick)) + "px " + std::to_string(reference_spp_of(spec, quick)) +
-           "spp";
+    std::set<std::string> groups;
+    if (measures_relmse(spec, task))
+        groups.insert(task.scene + " " + std::to_string(size_of(spec, quick)) + "px " +
+                      std::to_string(reference_spp_of(spec, quick)) + "spp");
+    ExperimentContext plan_only;  // the group functions load nothing
+    plan_only.quick = quick;
+    TaskCache unused;
+    for (const TaskVariant& v : task.variants) {
+        if (v.probe.empty() || !find_probe_references(v.probe)) continue;
+        const ProbeReferenceGroup* group = find_probe_reference_group(v.probe);
+        const ProbeCall call{spec, task, v, plan_only, size_of(spec, quick), frames_of(spec, quick),
+                             reference_spp_of(spec, quick), unused};
+        groups.insert(group ? (*group)(call) : spec.name + "/" + std::to_string(task.id));
+    }
+    groups.erase("");
+    if (groups.empty()) return "";
+    // References of several kinds: the task renders all of its own.
+    return groups.size() == 1 ? *groups.begin() : spec.name + "/" + std::to_string(task.id);
 }
 
 int render_task_references(const ExperimentSpec& spec, int task_id, const ExperimentContext& ctx) {

@@ -62,9 +62,11 @@ TEST(Compare, WritesImagesHeatMapsTableAndFiguresMeasuredAgainstTheReference) {
         EXPECT_LT(e["ssim"].get<double>(), 1.0);
     }
     // No staging folder is left behind (.references is the reference store).
-    for (const auto& entry : fs::directory_iterator(dir.parent_path()))
-        if (entry.path().filename() != ".references")
+    for (const auto& entry : fs::directory_iterator(dir.parent_path())) {
+        if (entry.path().filename() != ".references") {
             EXPECT_NE(entry.path().filename().string().rfind(".", 0), 0u) << entry.path();
+        }
+    }
     EXPECT_TRUE(fs::is_directory(dir.parent_path() / ".references"));
 }
 

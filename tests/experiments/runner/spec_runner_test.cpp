@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <gtest/gtest.h>
 #include "core/util/error.hpp"
@@ -263,6 +264,32 @@ TEST(SpecRunner, TheCommandPlansDeclaredExperimentsOnly) {
     bad_id.verb = "run-task";
     bad_id.arguments = {"pm-radius-sweep", "two"};
     EXPECT_NE(test::error_of([&] { run_task_command(bad_id, out); }).find("not a task id"), std::string::npos);
+}
+
+// Reference groups, from the plan alone: the tasks that compare against the same
+// path-traced references share one (a sweep renders each group's references once,
+// first), tasks that compare against none have none.
+TEST(SpecRunner, TasksThatNeedTheSameReferencesShareAGroup) {
+    auto groups = [](const std::string& name, bool quick) {
+        const ExperimentSpec& spec = *declared_experiment_named(name).spec;
+        std::vector<std::string> out;
+        for (const SpecTask& t : plan_tasks(spec, quick)) out.push_back(reference_group(spec, t, quick));
+        return out;
+    };
+    // relMSE against the scene camera's reference: one group for the four radii.
+    const std::vector<std::string> radius = groups("pm-radius-sweep", true);
+    ASSERT_EQ(radius.size(), 4u);
+    EXPECT_FALSE(radius[0].empty());
+    EXPECT_EQ(std::count(radius.begin(), radius.end(), radius[0]), 4);
+    // Ray throughput and the cone-traced images of Figs. 12/13 compare against nothing.
+    for (const std::string& g : groups("core-rays", true)) EXPECT_EQ(g, "");
+    for (const std::string& g : groups("vct-fig12-13", true)) EXPECT_EQ(g, "");
+    // pm-convergence: one group per scene (both halves of its reference).
+    const std::vector<std::string> convergence = groups("pm-convergence", false);
+    EXPECT_EQ(std::set<std::string>(convergence.begin(), convergence.end()).size(), 2u);
+    // vct-stability: only the path-traced leak task renders references.
+    const std::vector<std::string> stability = groups("vct-stability", true);
+    EXPECT_EQ(stability.size() - size_t(std::count(stability.begin(), stability.end(), "")), 1u);
 }
 
 }  // namespace
