@@ -160,6 +160,10 @@ int main(int argc, char** argv) {
     experiment->add_flag("--quick", quick, "small sizes (smoke run, minutes)");
     experiment->add_option("--results", results_dir, "results root directory")->capture_default_str();
     experiment->add_option("--seed", seed, "random seed")->capture_default_str();
+    std::vector<std::string> extra_axes;
+    experiment->add_option("--axis", extra_axes,
+                           "a declared experiment swept along one more axis, SETTING=V1,V2,... (repeatable); an axis "
+                           "of the experiment on that setting takes these values instead");
     bool resume = false;
     experiment->add_flag("--resume", resume,
                          "skip experiments whose results/NAME holds a finished run of this build with the same "
@@ -270,6 +274,7 @@ int main(int argc, char** argv) {
                 command.seed = seed;
                 command.threads = threads;
                 command.assets = assets;
+                command.axes = extra_axes;
                 return run_task_command(command, std::cout);
             }
             ExperimentBatch batch;
@@ -280,6 +285,11 @@ int main(int argc, char** argv) {
                 } else {
                     batch.experiments.push_back(&registry.get(name));  // an unknown name stops before anything runs
                 }
+            }
+            std::vector<Experiment> swept;  // with --axis: the experiments along their extra axes
+            if (!extra_axes.empty()) {
+                swept.reserve(batch.experiments.size());
+                for (const Experiment*& e : batch.experiments) e = &swept.emplace_back(declared_experiment_with_axes(e->name, extra_axes));
             }
             batch.results_root = results_dir;
             batch.quick = quick;

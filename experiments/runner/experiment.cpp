@@ -60,6 +60,32 @@ Experiment declared_experiment(ExperimentSpec spec) {
     return e;
 }
 
+namespace {
+
+// " --axis SETTING=V1,V2" for each axis of the experiment's spec that its declared spec
+// lacks or sweeps differently (with_extra_axes), so the table says how it was run.
+std::string swept_axes(const Experiment& experiment) {
+    const Experiment* declared = ExperimentRegistry::builtin().find(experiment.name);
+    if (!experiment.spec || !declared || !declared->spec) return "";
+    std::string out;
+    for (const SpecAxis& axis : experiment.spec->axes) {
+        if (axis.setting.empty()) continue;
+        const auto& declared_axes = declared->spec->axes;
+        const bool same = std::any_of(declared_axes.begin(), declared_axes.end(), [&axis](const SpecAxis& d) {
+            return d.setting == axis.setting && d.full == axis.full && d.quick == axis.quick;
+        });
+        if (same) continue;
+        out += " --axis " + axis.setting + "=";
+        for (size_t i = 0; i < axis.full.size(); ++i) {
+            if (i > 0) out += ',';
+            out += axis.full[i].is_string() ? axis.full[i].get<std::string>() : axis.full[i].dump();
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
 ExperimentOutput run_and_write(const Experiment& experiment, ExperimentContext context) {
     std::filesystem::create_directories(context.output_dir);
     Stopwatch watch;
@@ -109,7 +135,7 @@ ExperimentOutput run_and_write(const Experiment& experiment, ExperimentContext c
 
     std::ostringstream md;
     md << "# " << experiment.name << " — " << experiment.description << "\n\n";
-    md << "Measured by `gilab experiment " << experiment.name << (context.quick ? " --quick" : "")
+    md << "Measured by `gilab experiment " << experiment.name << (context.quick ? " --quick" : "") << swept_axes(experiment)
        << "` at revision `" << git_revision() << "`, seed " << context.seed << ", on "
        << doc["machine"].value("cpu", std::string("unknown CPU")) << " (" << doc["threads"] << " threads). "
        << "Columns named *paper …* are the published figures (reference data, the paper's hardware); "

@@ -1,5 +1,6 @@
 #include "experiments/runner/experiment_spec.hpp"
 
+#include <sstream>
 #include "core/util/error.hpp"
 #include "experiments/runner/spec_functions.hpp"
 #include "techniques/technique.hpp"
@@ -212,6 +213,37 @@ nlohmann::json SpecTask::to_json() const {
         j["variants"].push_back(jv);
     }
     return j;
+}
+
+ExperimentSpec with_extra_axes(ExperimentSpec spec, const std::vector<std::string>& axes) {
+    for (const std::string& text : axes) {
+        const size_t eq = text.find('=');
+        if (eq == 0 || eq == std::string::npos || eq + 1 == text.size())
+            throw Error("--axis " + text, "give SETTING=V1,V2,… (e.g. radius=0.05,0.1)");
+        const std::string setting = text.substr(0, eq);
+        std::vector<nlohmann::json> values;
+        std::stringstream list(text.substr(eq + 1));
+        for (std::string value; std::getline(list, value, ',');) {
+            if (value.empty()) throw Error("--axis " + text, "an empty value");
+            const nlohmann::json parsed = nlohmann::json::parse(value, nullptr, /*allow_exceptions=*/false);
+            values.push_back(parsed.is_discarded() ? nlohmann::json(value) : parsed);
+        }
+        bool replaced = false;
+        for (SpecAxis& a : spec.axes) {
+            if (a.setting == setting) {
+                a.full = a.quick = values;
+                replaced = true;
+            } else if (a.setting.empty() && !a.full.empty() && a.full.front().is_object() &&
+                       a.full.front().contains(setting)) {
+                throw Error("--axis " + text, "experiment '" + spec.name + "' sets '" + setting +
+                                                  "' together with other settings on one axis (a published table's "
+                                                  "rows); it cannot be swept on its own");
+            }
+        }
+        if (!replaced) spec.axes.push_back({setting, values, values});
+    }
+    spec.check();
+    return spec;
 }
 
 std::vector<SpecTask> plan_tasks(const ExperimentSpec& spec, bool quick) {

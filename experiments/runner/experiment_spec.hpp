@@ -103,6 +103,13 @@ struct SpecTask {
     nlohmann::json to_json() const;
 };
 
+// The spec swept along extra axes, each given as SETTING=V1,V2,… (values read as JSON
+// where they parse, else as text; the same for the full and the quick plan): an axis of
+// the spec on that setting gets these values, another setting becomes a new axis (the
+// innermost). Checked like any spec; an Error names the text when it is not
+// SETTING=VALUES, or the setting is one an axis of objects sets already.
+ExperimentSpec with_extra_axes(ExperimentSpec spec, const std::vector<std::string>& axes);
+
 // Every task of the spec, in plan order: scenes, then axes (the first axis outermost),
 // then variants.
 std::vector<SpecTask> plan_tasks(const ExperimentSpec& spec, bool quick);

@@ -281,6 +281,14 @@ fs::path spec_task_file(const fs::path& output_dir, int task_id, bool quick) {
     return output_dir / "tasks" / (quick ? "quick" : "full") / (std::to_string(task_id) + ".json");
 }
 
+bool holds_task_result(const ExperimentSpec& spec, const SpecTask& task, bool quick, uint64_t seed, const fs::path& file) {
+    std::ifstream in(file);
+    if (!in) return false;
+    const nlohmann::json result = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    return !result.is_discarded() && result.is_object() &&
+           identity_mismatch(result, task_identity(spec, task, quick, seed), quick).empty();
+}
+
 nlohmann::json run_spec_task(const ExperimentSpec& spec, int task_id, const ExperimentContext& ctx) {
     const std::vector<SpecTask> tasks = plan_tasks(spec, ctx.quick);
     TaskCache cache;

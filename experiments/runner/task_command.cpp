@@ -25,6 +25,11 @@ const Experiment& declared_experiment_named(const std::string& name) {
     return e;
 }
 
+Experiment declared_experiment_with_axes(const std::string& name, const std::vector<std::string>& axes) {
+    const Experiment& declared = declared_experiment_named(name);
+    return axes.empty() ? declared : declared_experiment(with_extra_axes(*declared.spec, axes));
+}
+
 namespace {
 
 int task_id(const std::string& text) {
@@ -42,7 +47,7 @@ int run_task_command(const TaskCommand& c, std::ostream& out) {
     if (c.arguments.size() != (one_task ? 2u : 1u))
         throw Error(c.verb, one_task ? "needs an experiment name and a task id: " + c.verb + " NAME ID"
                                      : "needs one experiment name: " + c.verb + " NAME");
-    const Experiment& e = declared_experiment_named(c.arguments[0]);
+    const Experiment e = declared_experiment_with_axes(c.arguments[0], c.axes);
     ExperimentContext ctx;
     ctx.quick = c.quick;
     ctx.output_dir = c.results_root / e.name;
@@ -86,7 +91,7 @@ int run_task_command(const TaskCommand& c, std::ostream& out) {
                                         " plan has run under " + c.results_root.string() +
                                         " (run-task writes there; check --results and --quick)");
     Experiment merging = e;
-    merging.run = [&e](const ExperimentContext& context) { return merge_spec_tasks(*e.spec, context); };
+    merging.run = [spec = e.spec](const ExperimentContext& context) { return merge_spec_tasks(*spec, context); };
     run_and_write(merging, ctx);
     out << "wrote " << (ctx.output_dir / "table.md").string() << "\n";
     return 0;

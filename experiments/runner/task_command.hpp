@@ -18,12 +18,15 @@ struct TaskCommand {
     uint64_t seed = 1;
     int threads = 0;
     AssetPaths assets;
+    std::vector<std::string> axes;        // extra sweep axes, SETTING=V1,V2,… (with_extra_axes)
 };
 
 // The registered experiment `name` if it is declared as a spec; else an Error saying it
 // runs only whole and naming the declared ones.
 struct Experiment;
 const Experiment& declared_experiment_named(const std::string& name);
+// The same, swept along extra axes too (with_extra_axes); without any, the declared one.
+Experiment declared_experiment_with_axes(const std::string& name, const std::vector<std::string>& axes);
 
 // plan: one JSON line per task (id, scene, axes, variants with technique or probe and
 // settings; seconds_last_run when RESULTS/NAME/tasks holds this task's result, as a

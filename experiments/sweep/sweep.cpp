@@ -16,8 +16,19 @@ namespace gilab {
 
 namespace fs = std::filesystem;
 
+const SweepExperiment& Sweep::experiment(const std::string& name) const {
+    const std::string key = name + (quick ? " quick" : " full");
+    auto it = made->find(key);
+    if (it == made->end()) {
+        SweepExperiment e{declared_experiment_with_axes(name, axes), {}};
+        e.plan = plan_tasks(*e.experiment.spec, quick);
+        it = made->emplace(key, std::move(e)).first;
+    }
+    return it->second;
+}
+
 nlohmann::json Sweep::to_json() const {
-    return {{"experiments", experiments}, {"quick", quick},     {"seed", seed},
+    return {{"experiments", experiments}, {"axes", axes}, {"quick", quick},     {"seed", seed},
             {"results", results_root.string()}, {"assets", assets}, {"gilab", gilab.string()},
             {"on", on},                   {"slurm", slurm},     {"submissions", submissions}};
 }
@@ -25,6 +36,7 @@ nlohmann::json Sweep::to_json() const {
 Sweep Sweep::from_json(const nlohmann::json& j) {
     Sweep s;
     s.experiments = j.at("experiments").get<std::vector<std::string>>();
+    s.axes = j.value("axes", std::vector<std::string>());
     s.quick = j.at("quick").get<bool>();
     s.seed = j.at("seed").get<uint64_t>();
     s.results_root = j.at("results").get<std::string>();
@@ -56,8 +68,7 @@ std::vector<std::string> sweep_experiment_names(const std::vector<std::string>& 
 std::vector<SweepTask> sweep_tasks(const Sweep& sweep) {
     std::vector<SweepTask> tasks;
     for (const std::string& name : sweep.experiments)
-        for (const SpecTask& t : plan_tasks(*declared_experiment_named(name).spec, sweep.quick))
-            tasks.push_back({name, t.id});
+        for (const SpecTask& t : sweep.experiment(name).plan) tasks.push_back({name, t.id});
     return tasks;
 }
 
@@ -65,7 +76,11 @@ fs::path task_result_file(const Sweep& sweep, const SweepTask& task) {
     return spec_task_file(sweep.results_root / task.experiment, task.id, sweep.quick);
 }
 
-bool task_done(const Sweep& sweep, const SweepTask& task) { return fs::exists(task_result_file(sweep, task)); }
+bool task_done(const Sweep& sweep, const SweepTask& task) {
+    const SweepExperiment& e = sweep.experiment(task.experiment);
+    return holds_task_result(*e.experiment.spec, e.plan.at(size_t(task.id)), sweep.quick, sweep.seed,
+                             task_result_file(sweep, task));
+}
 
 std::vector<SweepTask> tasks_without_result(const Sweep& sweep) {
     std::vector<SweepTask> pending;
@@ -79,6 +94,7 @@ namespace {
 std::vector<std::string> experiment_arguments(const Sweep& sweep, const std::string& verb, const SweepTask& task) {
     std::vector<std::string> args = {"experiment", verb, task.experiment, std::to_string(task.id)};
     if (sweep.quick) args.push_back("--quick");
+    for (const std::string& axis : sweep.axes) args.insert(args.end(), {"--axis", axis});
     args.insert(args.end(), {"--seed", std::to_string(sweep.seed), "--results", sweep.results_root.string()});
     return args;
 }
@@ -96,12 +112,9 @@ std::vector<std::string> references_arguments(const Sweep& sweep, const SweepTas
 std::vector<SweepTask> reference_tasks(const Sweep& sweep, const std::vector<SweepTask>& tasks) {
     std::set<std::string> groups;
     std::vector<SweepTask> out;
-    std::map<std::string, std::vector<SpecTask>> plans;
     for (const SweepTask& t : tasks) {
-        const ExperimentSpec& spec = *declared_experiment_named(t.experiment).spec;
-        auto plan = plans.find(t.experiment);
-        if (plan == plans.end()) plan = plans.emplace(t.experiment, plan_tasks(spec, sweep.quick)).first;
-        const std::string group = reference_group(spec, plan->second.at(size_t(t.id)), sweep.quick);
+        const SweepExperiment& e = sweep.experiment(t.experiment);
+        const std::string group = reference_group(*e.experiment.spec, e.plan.at(size_t(t.id)), sweep.quick);
         if (!group.empty() && groups.insert(group).second) out.push_back(t);
     }
     return out;
@@ -141,7 +154,7 @@ void merge_published(const Sweep& sweep, const Experiment& e, std::ostream& out)
     ctx.assets = AssetPaths::from_environment(sweep.assets.empty() ? std::nullopt : std::optional(sweep.assets));
     ctx.seed = sweep.seed;
     Experiment merging = e;
-    merging.run = [&e](const ExperimentContext& context) { return merge_spec_tasks(*e.spec, context); };
+    merging.run = [spec = e.spec](const ExperimentContext& context) { return merge_spec_tasks(*spec, context); };
     try {
         const ExperimentOutput output = run_and_write(merging, ctx);
         publish_directory(staging, final_dir);
@@ -162,7 +175,7 @@ int merge_sweep(const Sweep& sweep, std::ostream& out, std::ostream& err) {
     int failures = 0;
     for (const std::string& name : sweep.experiments) {
         try {
-            merge_published(sweep, declared_experiment_named(name), out);
+            merge_published(sweep, sweep.experiment(name).experiment, out);
         } catch (const Error& e) {
             err << "gilab: sweep: cannot merge " << name << ": " << e.what() << std::endl;
             ++failures;

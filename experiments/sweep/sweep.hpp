@@ -7,10 +7,14 @@
 // lets `gilab sweep status | resume | merge DIR` pick it up later, on another machine too.
 #include <cstdint>
 #include <filesystem>
+#include <map>
+#include <memory>
 #include <ostream>
 #include <string>
 #include <vector>
 #include <nlohmann/json.hpp>
+#include "experiments/runner/experiment.hpp"
+#include "experiments/runner/experiment_spec.hpp"
 
 namespace gilab {
 
@@ -19,8 +23,15 @@ struct SweepTask {
     int id = 0;  // in the experiment's plan
 };
 
+// An experiment of a sweep: the declared one along the sweep's extra axes, and its plan.
+struct SweepExperiment {
+    Experiment experiment;
+    std::vector<SpecTask> plan;
+};
+
 struct Sweep {
     std::vector<std::string> experiments;  // declared experiments, in the order given
+    std::vector<std::string> axes;         // extra axes for all of them, SETTING=V1,V2,… (with_extra_axes)
     bool quick = false;
     uint64_t seed = 1;
     std::filesystem::path results_root;    // absolute: the tasks may run elsewhere
@@ -29,8 +40,12 @@ struct Sweep {
     std::string on = "local";              // local | slurm
     nlohmann::json slurm = nlohmann::json::object();        // the Slurm options (sweep_slurm.hpp)
     nlohmann::json submissions = nlohmann::json::array();   // one object per submitted round
+    // experiment()'s, by name and plan size; shared by copies of the sweep.
+    mutable std::shared_ptr<std::map<std::string, SweepExperiment>> made = std::make_shared<std::map<std::string, SweepExperiment>>();
 
     std::filesystem::path directory() const { return results_root / ".sweep"; }
+    // Experiment `name` of the sweep, made once (its spec checked with the axes).
+    const SweepExperiment& experiment(const std::string& name) const;
     nlohmann::json to_json() const;
     static Sweep from_json(const nlohmann::json& j);
 };
@@ -42,7 +57,8 @@ std::vector<std::string> sweep_experiment_names(const std::vector<std::string>& 
 // Every task of every experiment of the sweep, experiment by experiment in plan order.
 std::vector<SweepTask> sweep_tasks(const Sweep& sweep);
 
-// The task's result file, and whether it is there.
+// The task's result file, and whether it holds this task's result (one written for
+// another plan — another seed, spec or axes — is not).
 std::filesystem::path task_result_file(const Sweep& sweep, const SweepTask& task);
 bool task_done(const Sweep& sweep, const SweepTask& task);
 std::vector<SweepTask> tasks_without_result(const Sweep& sweep);

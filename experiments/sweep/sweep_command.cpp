@@ -14,6 +14,10 @@ CLI::App* add_sweep_subcommand(CLI::App& app, SweepCommand& c) {
                  "`resume DIR` and `merge DIR` for the sweep folder RESULTS/.sweep");
     sweep->add_option("names", c.arguments, "experiment names or `all`; or status|resume|merge DIR")->required();
     sweep->add_flag("--quick", c.quick, "the quick plans (small sizes)");
+    sweep->add_option("--axis", c.axes,
+                      "sweep every named experiment along one more axis, SETTING=V1,V2,... (repeatable); an axis of "
+                      "the experiment on that setting takes these values instead. Use a --results of its own: the "
+                      "tasks are numbered anew");
     sweep->add_option("--results", c.results, "results root directory (on a cluster: on the shared filesystem)")
         ->capture_default_str();
     sweep->add_option("--seed", c.seed, "random seed")->capture_default_str();
@@ -54,7 +58,7 @@ void require_no_sweep_options(const SweepCommand& c) {
     SlurmSweepOptions slurm = c.slurm;
     slurm.dry_run = false;
     if (c.quick != defaults.quick || c.results != defaults.results || c.seed != defaults.seed || c.on != defaults.on ||
-        slurm.to_json() != defaults.slurm.to_json())
+        !c.axes.empty() || slurm.to_json() != defaults.slurm.to_json())
         throw Error("sweep " + c.arguments[0], "takes the sweep's own options from its sweep.json; give only the folder "
                                                "(and --jobs or --dry-run for resume)");
 }
@@ -151,7 +155,9 @@ int run_sweep_command(const SweepCommand& c, std::ostream& out, std::ostream& er
     }
     Sweep sweep;
     sweep.experiments = sweep_experiment_names(c.arguments);
+    sweep.axes = c.axes;
     sweep.quick = c.quick;
+    for (const std::string& name : sweep.experiments) sweep.experiment(name);  // the axes apply to each: checked now
     sweep.seed = c.seed;
     sweep.results_root = fs::absolute(c.results).lexically_normal();
     if (!sweep.results_root.has_filename()) sweep.results_root = sweep.results_root.parent_path();

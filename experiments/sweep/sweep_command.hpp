@@ -1,7 +1,8 @@
 #pragma once
 // `gilab sweep`: the tasks of several declared experiments here or on a Slurm cluster.
 //
-//   gilab sweep NAMES...|all [--quick] [--results DIR] [--seed N] [--on local|slurm] ...
+//   gilab sweep NAMES...|all [--quick] [--axis SETTING=V1,V2,...] [--results DIR] [--seed N]
+//               [--on local|slurm] ...
 //   gilab sweep status DIR    tasks done / running / pending / failed
 //   gilab sweep resume DIR    runs (or submits) only the tasks without a result
 //   gilab sweep merge DIR     the tables and the report from the results there are
@@ -19,6 +20,7 @@ namespace gilab {
 struct SweepCommand {
     std::vector<std::string> arguments;  // names, or status|resume|merge DIR
     bool quick = false;
+    std::vector<std::string> axes;  // extra sweep axes, SETTING=V1,V2,…
     std::string results = "results";
     uint64_t seed = 1;
     std::string on = "local";

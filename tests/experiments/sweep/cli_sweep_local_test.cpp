@@ -150,6 +150,38 @@ TEST_F(SweepLocal, AFailedTaskIsMissingFromTheMergeUntilResumed) {
     EXPECT_TRUE(contains(run_gilab({"sweep", "status", (results / ".sweep").string()}).output, "total: 7 done, 0 running"));
 }
 
+// --axis: the experiment swept along other values; the tables say so. A result written
+// for another plan (another seed) is not taken for this one's.
+TEST_F(SweepLocal, ExtraAxesAndOtherPlansResults) {
+    const fs::path results = gilab::test::temp_dir("sweep_local_axes");
+    const std::vector<std::string> args = {"sweep", "pm-radius-sweep", "--quick", "--axis", "radius=0.05,0.2",
+                                           "--axis", "photons=1024", "--results", results.string()};
+    const GilabRun swept = run_gilab(args);
+    ASSERT_EQ(swept.exit_code, 0) << swept.output;
+    EXPECT_TRUE(contains(swept.output, "2 tasks of 1 experiment(s)")) << swept.output;
+    const nlohmann::json merged = read_json(results / "pm-radius-sweep" / "results.json");
+    const nlohmann::json& rows = merged["tables"][0]["rows"];
+    ASSERT_EQ(rows.size(), 2u);
+    EXPECT_EQ(rows[0]["radius (scene units)"], 0.05);
+    EXPECT_EQ(rows[1]["radius (scene units)"], 0.2);
+    EXPECT_EQ(rows[0]["photons (emitted per frame)"], 1024);
+    std::ifstream table(results / "pm-radius-sweep" / "table.md");
+    const std::string text{std::istreambuf_iterator<char>(table), std::istreambuf_iterator<char>()};
+    EXPECT_TRUE(contains(text, "--quick --axis photons=1024 --axis radius=0.05,0.2`")) << text;
+
+    std::vector<std::string> other_seed = args;
+    other_seed.insert(other_seed.end(), {"--seed", "2"});
+    const GilabRun again = run_gilab(other_seed);
+    ASSERT_EQ(again.exit_code, 0) << again.output;
+    EXPECT_TRUE(contains(again.output, "0 have a result already, 2 to run")) << again.output;
+    EXPECT_EQ(read_json(results / "pm-radius-sweep" / "results.json")["config"]["effective"]["tasks_missing"].size(), 0u);
+
+    const GilabRun object_axis = run_gilab({"sweep", "pm-table1", "--quick", "--axis", "radius=0.05", "--results",
+                                            results.string()});
+    EXPECT_NE(object_axis.exit_code, 0);
+    EXPECT_TRUE(contains(object_axis.output, "cannot be swept on its own")) << object_axis.output;
+}
+
 TEST(SweepLocalBadInput, ErrorsNameTheProblemAndExitNonZero) {
     const fs::path results = gilab::test::temp_dir("sweep_bad_input");
     const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
@@ -162,6 +194,9 @@ TEST(SweepLocalBadInput, ErrorsNameTheProblemAndExitNonZero) {
         {{"sweep", "status"}, "needs one folder"},
         {{"sweep", "resume", results.string(), "--quick"}, "takes the sweep's own options"},
         {{"sweep", "merge", results.string(), "--on", "slurm"}, "takes the sweep's own options"},
+        {{"sweep", "core-rays", "--axis", "threads"}, "give SETTING=V1,V2"},
+        {{"sweep", "pm-radius-sweep", "--axis", "no_such_setting=1"}, "is not a setting of technique"},
+        {{"sweep", "status", results.string(), "--axis", "radius=1"}, "takes the sweep's own options"},
     };
     for (const auto& [args, message] : cases) {
         std::vector<std::string> with_results = args;

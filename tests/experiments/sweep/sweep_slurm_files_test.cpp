@@ -178,3 +178,18 @@ TEST(SweepSlurmFiles, WithoutSbatchTheErrorSaysHowToGetItOrRunLocally) {
     EXPECT_TRUE(contains(error, "--on local")) << error;
     EXPECT_FALSE(fs::exists(sweep.directory() / "sweep.json")) << "a sweep that was not submitted was recorded";
 }
+
+TEST(SweepSlurmFiles, ExtraAxesGoToEveryTaskLine) {
+    Sweep sweep = two_experiment_sweep("sweep_axes");
+    sweep.experiments = {"pm-radius-sweep"};
+    sweep.axes = {"radius=0.05,0.2"};
+    const std::vector<SweepTask> tasks = sweep_tasks(sweep);
+    ASSERT_EQ(tasks.size(), 4u);  // 2 photon counts × the 2 radii given
+    SlurmSweepOptions options;
+    options.dry_run = true;
+    std::ostringstream out;
+    submit_sweep_round(sweep, tasks, options, out);
+    for (const std::string& line : lines_of(read_text(sweep.directory() / "tasks.1.txt")))
+        EXPECT_TRUE(contains(line, " --quick --axis radius=0.05,0.2 --seed 7 ")) << line;
+    EXPECT_EQ(load_sweep(sweep.directory()).axes, sweep.axes);
+}
