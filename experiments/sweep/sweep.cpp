@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <fstream>
+#include <functional>
 #include <map>
+#include <queue>
 #include <set>
 #include "core/image/image_io.hpp"
 #include "core/util/error.hpp"
@@ -80,6 +82,30 @@ bool task_done(const Sweep& sweep, const SweepTask& task) {
     const SweepExperiment& e = sweep.experiment(task.experiment);
     return holds_task_result(*e.experiment.spec, e.plan.at(size_t(task.id)), sweep.quick, sweep.seed,
                              task_result_file(sweep, task));
+}
+
+std::optional<double> task_seconds(const Sweep& sweep, const SweepTask& task) {
+    if (!task_done(sweep, task)) return std::nullopt;
+    std::ifstream in(task_result_file(sweep, task));
+    const nlohmann::json result = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    if (result.is_discarded() || !result.contains("seconds") || !result["seconds"].is_number()) return std::nullopt;
+    return result["seconds"].get<double>();
+}
+
+double wall_seconds_on(std::vector<double> seconds, int slots) {
+    if (slots < 1) throw Error("wall_seconds_on", "needs at least one machine");
+    std::sort(seconds.begin(), seconds.end(), std::greater<>());
+    // Each machine's finishing time, the one free first on top.
+    std::priority_queue<double, std::vector<double>, std::greater<>> free_at;
+    for (int i = 0; i < slots; ++i) free_at.push(0.0);
+    double wall = 0.0;
+    for (double s : seconds) {
+        const double end = free_at.top() + s;
+        free_at.pop();
+        free_at.push(end);
+        wall = std::max(wall, end);
+    }
+    return wall;
 }
 
 std::vector<SweepTask> tasks_without_result(const Sweep& sweep) {

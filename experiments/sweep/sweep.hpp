@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -74,6 +75,14 @@ std::vector<std::string> run_task_arguments(const Sweep& sweep, const SweepTask&
 // RESULTS/.references; a task whose references are there only reads them.
 std::vector<SweepTask> reference_tasks(const Sweep& sweep, const std::vector<SweepTask>& tasks);
 std::vector<std::string> references_arguments(const Sweep& sweep, const SweepTask& task);
+
+// The time the task's result says it took (its `seconds`), or nothing without a result.
+std::optional<double> task_seconds(const Sweep& sweep, const SweepTask& task);
+
+// The wall time of tasks taking `seconds` each on `slots` machines that each run one task
+// at a time, the longest tasks first, each to the machine free first (LPT list
+// scheduling: within 4/3 of the best order). Never less than the longest task.
+double wall_seconds_on(std::vector<double> seconds, int slots);
 
 // Writes and reads DIR/sweep.json (atomically); reading names the file on a bad one.
 void save_sweep(const Sweep& sweep);

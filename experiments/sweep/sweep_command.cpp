@@ -69,6 +69,40 @@ fs::path sweep_folder(const SweepCommand& c) {
     return c.arguments[1];
 }
 
+std::string duration(double seconds) {
+    char text[64];
+    if (seconds < 120) std::snprintf(text, sizeof text, "%.1f s", seconds);
+    else if (seconds < 7200) std::snprintf(text, sizeof text, "%.1f min", seconds / 60);
+    else std::snprintf(text, sizeof text, "%.2f h", seconds / 3600);
+    return text;
+}
+
+// The task times the results hold: their sum, the longest task, and the wall time they
+// would take on 1, 4 and 16 machines running one task each at a time.
+void print_measured_times(const Sweep& sweep, std::ostream& out) {
+    std::vector<double> seconds;
+    double longest = 0;
+    std::string longest_task;
+    for (const SweepTask& t : sweep_tasks(sweep)) {
+        const std::optional<double> s = task_seconds(sweep, t);
+        if (!s) continue;
+        seconds.push_back(*s);
+        if (*s > longest) {
+            longest = *s;
+            longest_task = t.experiment + " task " + std::to_string(t.id);
+        }
+    }
+    if (seconds.empty()) return;
+    double sum = 0;
+    for (double s : seconds) sum += s;
+    out << "task time of the " << seconds.size() << " results: " << duration(sum) << " in all, longest "
+        << duration(longest) << " (" << longest_task << "); one task at a time per machine, longest first: ";
+    for (int machines : {1, 4, 16})
+        out << machines << (machines == 1 ? " machine " : " machines ") << duration(wall_seconds_on(seconds, machines))
+            << (machines == 16 ? "" : ", ");
+    out << " (references rendered before the tasks, as sweeps do, are not in the results)" << std::endl;
+}
+
 int show_status(const Sweep& sweep, std::ostream& out) {
     SlurmTaskStates slurm;
     if (sweep.on == "slurm") slurm = query_slurm_states(sweep);
@@ -103,6 +137,7 @@ int show_status(const Sweep& sweep, std::ostream& out) {
         }
         out << std::endl;
     }
+    print_measured_times(sweep, out);
     out << "total: " << totals["done"] << " done, " << totals["running"] << " running, " << totals["pending"]
         << " pending, " << totals["failed"] << " failed";
     if (totals["without result"]) out << ", " << totals["without result"] << " without result (failed or not run)";

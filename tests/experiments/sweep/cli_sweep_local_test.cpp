@@ -147,7 +147,10 @@ TEST_F(SweepLocal, AFailedTaskIsMissingFromTheMergeUntilResumed) {
     ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
     EXPECT_TRUE(contains(resumed.output, "6 have a result already, 1 to run")) << resumed.output;
     EXPECT_TRUE(read_json(results / "pm-radius-sweep" / "results.json")["config"]["effective"]["tasks_missing"].empty());
-    EXPECT_TRUE(contains(run_gilab({"sweep", "status", (results / ".sweep").string()}).output, "total: 7 done, 0 running"));
+    const std::string done = run_gilab({"sweep", "status", (results / ".sweep").string()}).output;
+    EXPECT_TRUE(contains(done, "total: 7 done, 0 running")) << done;
+    EXPECT_TRUE(contains(done, "task time of the 7 results: ")) << done;
+    EXPECT_TRUE(contains(done, "16 machines ")) << done;
 }
 
 // --axis: the experiment swept along other values; the tables say so. A result written
