@@ -1,12 +1,15 @@
 #include "experiments/sweep/sweep_slurm.hpp"
 
+#include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
 #include "core/image/image_io.hpp"
 #include "core/util/error.hpp"
 #include "experiments/sweep/program_call.hpp"
+#include "experiments/sweep/task_costs.hpp"
 
 namespace gilab {
 
@@ -178,9 +181,36 @@ std::string merge_script(const Sweep& sweep, const SlurmSweepOptions& o, int rou
     return s.str();
 }
 
-void submit_sweep_round(Sweep& sweep, const std::vector<SweepTask>& tasks, const SlurmSweepOptions& options,
+std::string default_time_limit(const Sweep& sweep, const std::vector<SweepTask>& tasks, std::string& why) {
+    double longest = 0;
+    std::set<std::string> unmeasured;
+    for (const SweepTask& t : tasks) {
+        if (const std::optional<double> s = longest_task_seconds(t.experiment, sweep.quick)) longest = std::max(longest, *s);
+        else unmeasured.insert(t.experiment);
+    }
+    if (!unmeasured.empty() || !sweep.axes.empty()) {
+        std::string names;
+        for (const std::string& n : unmeasured) names += (names.empty() ? "" : ", ") + n;
+        why = !sweep.axes.empty() ? "no --time: extra axes change the tasks' cost, so the cluster's default limit applies"
+                                  : "no --time: the cluster's default limit applies (no measured task time for " + names +
+                                        " in experiments/sweep/task_costs.json)";
+        return "";
+    }
+    const long minutes = std::max(10L, long(std::ceil(3.0 * longest / 60.0)));
+    why = "time limit per task: " + std::to_string(minutes) + " min, 3 × the longest task measured for these experiments (" +
+          task_costs_measured_on() + "; --time overrides)";
+    return std::to_string(minutes);
+}
+
+void submit_sweep_round(Sweep& sweep, const std::vector<SweepTask>& tasks, const SlurmSweepOptions& given,
                         std::ostream& out) {
-    options.check();
+    given.check();
+    SlurmSweepOptions options = given;
+    if (options.time.empty() && !tasks.empty()) {
+        std::string why;
+        options.time = default_time_limit(sweep, tasks, why);
+        out << why << std::endl;
+    }
     require_one_word(sweep.results_root.string(), "--results");
     require_one_word(sweep.gilab.string(), "the gilab program's path");
     require_one_word(sweep.assets, "--assets");
@@ -213,7 +243,7 @@ void submit_sweep_round(Sweep& sweep, const std::vector<SweepTask>& tasks, const
                              {"references_job", ""},
                              {"array_job", ""},
                              {"merge_job", ""}};
-    sweep.slurm = options.to_json();
+    sweep.slurm = given.to_json();  // a resumed round takes its default time limit anew
     out << "wrote " << list_file(sweep, round, ArrayKind::Tasks).string() << " (" << tasks.size() << " tasks), "
         << array_file.string() << " and " << merge_file.string();
     if (!references.empty())

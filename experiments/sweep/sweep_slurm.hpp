@@ -53,6 +53,11 @@ std::string array_script(const Sweep& sweep, const SlurmSweepOptions& options, s
                          ArrayKind kind = ArrayKind::Tasks);
 std::string merge_script(const Sweep& sweep, const SlurmSweepOptions& options, int round);
 
+// The time limit per task when --time is not given, in minutes: 3 × the longest task
+// measured for the experiments of `tasks` (task_costs.hpp), at least 10; "" when one of
+// them has no measurement or the sweep has extra axes. `why` says which and why.
+std::string default_time_limit(const Sweep& sweep, const std::vector<SweepTask>& tasks, std::string& why);
+
 // Writes round R's files (R = submissions so far + 1) for `tasks` and, unless dry_run,
 // submits them; records the round in `sweep` and saves sweep.json. Prints the job ids
 // and how to watch them. Error when sbatch is missing or refuses (with its message).

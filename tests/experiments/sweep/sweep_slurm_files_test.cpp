@@ -2,11 +2,13 @@
 // script say what Slurm must run, batches keep the array small, bad options are refused,
 // and a missing sbatch is said plainly. Nothing here needs Slurm (sweep_slurm.sh does).
 #include <gtest/gtest.h>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <sstream>
 #include "experiments/sweep/sweep_slurm.hpp"
+#include "experiments/sweep/task_costs.hpp"
 #include "tests/test_support.hpp"
 
 namespace fs = std::filesystem;
@@ -192,4 +194,31 @@ TEST(SweepSlurmFiles, ExtraAxesGoToEveryTaskLine) {
     for (const std::string& line : lines_of(read_text(sweep.directory() / "tasks.1.txt")))
         EXPECT_TRUE(contains(line, " --quick --axis radius=0.05,0.2 --seed 7 ")) << line;
     EXPECT_EQ(load_sweep(sweep.directory()).axes, sweep.axes);
+}
+
+// Without --time: 3 × the longest task measured for the experiments (at least 10 min),
+// or none (the cluster's default) for experiments never measured or with extra axes.
+TEST(SweepSlurmFiles, DefaultTimeLimitFromTheMeasuredTaskTimes) {
+    Sweep sweep = two_experiment_sweep("sweep_default_time");
+    const std::vector<SweepTask> tasks = sweep_tasks(sweep);
+    std::string why;
+    ASSERT_TRUE(longest_task_seconds("pm-radius-sweep", true).has_value());
+    const double longest = std::max(*longest_task_seconds("core-rays", true), *longest_task_seconds("pm-radius-sweep", true));
+    const long expected = std::max(10L, long(std::ceil(3 * longest / 60)));
+    EXPECT_EQ(default_time_limit(sweep, tasks, why), std::to_string(expected));
+    EXPECT_TRUE(contains(why, "3 × the longest task measured")) << why;
+    SlurmSweepOptions options;
+    options.dry_run = true;
+    std::ostringstream out;
+    submit_sweep_round(sweep, tasks, options, out);
+    EXPECT_TRUE(contains(read_text(sweep.directory() / "array.1.sbatch"), "#SBATCH --time=" + std::to_string(expected) + "\n"));
+    EXPECT_EQ(load_sweep(sweep.directory()).slurm.value("time", "?"), "") << "resumed rounds take the default anew";
+
+    sweep.axes = {"radius=0.05"};
+    sweep.experiments = {"pm-radius-sweep"};
+    EXPECT_EQ(default_time_limit(sweep, sweep_tasks(sweep), why), "");
+    EXPECT_TRUE(contains(why, "extra axes")) << why;
+    sweep.axes.clear();
+    EXPECT_EQ(default_time_limit(sweep, {SweepTask{"no-such-measurement", 0}}, why), "");
+    EXPECT_TRUE(contains(why, "no measured task time for no-such-measurement")) << why;
 }
