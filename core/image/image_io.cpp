@@ -24,6 +24,7 @@
 #include <vector>
 #include "core/util/build_info.hpp"
 #include "core/util/error.hpp"
+#include "core/util/temporary_path.hpp"
 
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
@@ -37,17 +38,8 @@ namespace {
 // A temporary sibling of the target; removed unless commit() renamed it into place.
 class TempFile {
 public:
-    explicit TempFile(const fs::path& target) : target_(target) {
+    explicit TempFile(const fs::path& target) : target_(target), path_(temporary_sibling(target)) {
         if (!target.has_filename()) throw Error(target.string(), "not a file path");
-        static std::atomic<uint64_t> counter{0};
-        // Appended piecewise: GCC 12 warns falsely (-Wrestrict) on "." + std::string.
-        std::string name(1, '.');
-        name += target.filename().string();
-        name += ".tmp.";
-        name += std::to_string(::getpid());
-        name += '.';
-        name += std::to_string(counter++);
-        path_ = target.parent_path() / name;
     }
     ~TempFile() {
         if (!committed_) {

@@ -12,6 +12,7 @@
 #include <optional>
 #include <thread>
 #include "core/util/error.hpp"
+#include "core/util/temporary_path.hpp"
 
 namespace gilab {
 
@@ -19,16 +20,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string host_name() {
-    char name[256] = {};
-    gethostname(name, sizeof name - 1);
-    return name;
-}
-
 struct Holder {
     std::string host;
     long pid = 0;
+    bool operator==(const Holder&) const = default;
+    std::string text() const { return "process " + std::to_string(pid) + " on " + host; }
 };
+
+Holder me() { return {host_name(), long(getpid())}; }
 
 std::optional<Holder> read_holder(const fs::path& marker) {
     std::ifstream in(marker);
@@ -37,14 +36,15 @@ std::optional<Holder> read_holder(const fs::path& marker) {
     return std::nullopt;  // gone, or created but not written yet
 }
 
-// Creates the marker if nobody holds it; false when it exists.
+// Creates the marker naming this process if nobody holds it; false when it exists.
 bool take_marker(const fs::path& marker) {
     const int fd = open(marker.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
     if (fd < 0) {
         if (errno == EEXIST) return false;
         throw Error(marker.string(), std::string("cannot create the marker: ") + std::strerror(errno));
     }
-    const std::string text = host_name() + " " + std::to_string(getpid()) + "\n";
+    const Holder self = me();
+    const std::string text = self.host + " " + std::to_string(self.pid) + "\n";
     const bool written = ::write(fd, text.data(), text.size()) == ssize_t(text.size());
     close(fd);
     if (!written) {
@@ -52,6 +52,18 @@ bool take_marker(const fs::path& marker) {
         throw Error(marker.string(), "cannot write the marker");
     }
     return true;
+}
+
+// Removes the marker only while it names `holder`: one taken over meanwhile is another's.
+// The marker is first renamed away, so a marker created after the look is never removed;
+// one renamed away by mistake is put back unless a newer one exists.
+void remove_marker_of(const fs::path& marker, const Holder& holder) {
+    const fs::path aside = temporary_sibling(marker);
+    std::error_code ec;
+    fs::rename(marker, aside, ec);
+    if (ec) return;  // gone already
+    if (read_holder(aside) != holder) fs::create_hard_link(aside, marker, ec);
+    fs::remove(aside, ec);
 }
 
 // Refreshes the marker's modification time every `period` until destroyed.
@@ -81,16 +93,9 @@ private:
     std::thread thread_;
 };
 
-fs::path temporary_beside(const fs::path& target) {
-    std::string name = ".";
-    for (const std::string& part : {target.stem().string(), host_name(), std::to_string(getpid())}) name += part + ".";
-    name.pop_back();
-    return target.parent_path() / (name + target.extension().string());
-}
-
-bool compute(const fs::path& target, const fs::path& marker,
-             const std::function<void(const fs::path&)>& write, const ProduceOnceOptions& options) {
-    const fs::path temporary = temporary_beside(target);
+bool compute(const fs::path& target, const fs::path& marker, const std::function<void(const fs::path&)>& write,
+             const ProduceOnceOptions& options) {
+    const fs::path temporary = temporary_sibling(target);
     std::error_code ec;
     try {
         Heartbeat heartbeat(marker, options.heartbeat);
@@ -99,11 +104,18 @@ bool compute(const fs::path& target, const fs::path& marker,
         fs::rename(temporary, target);
     } catch (...) {
         fs::remove(temporary, ec);
-        fs::remove(marker, ec);
+        remove_marker_of(marker, me());
         throw;
     }
-    fs::remove(marker, ec);
+    remove_marker_of(marker, me());
     return true;
+}
+
+// What a holder that died while writing left: its temporaries of the target.
+void remove_leftovers(const fs::path& target, const Holder& dead) {
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(target.parent_path(), ec))
+        if (is_temporary_of(entry.path(), target, dead.host, dead.pid)) fs::remove(entry.path(), ec);
 }
 
 }  // namespace
@@ -114,7 +126,8 @@ bool produce_file_once(const fs::path& target, const std::function<void(const fs
     fs::path marker = target;
     marker += ".computing";
     const std::string host = host_name();
-    std::optional<fs::file_time_type> seen;  // the marker's time when last looked at
+    fs::file_time_type seen{};  // the marker's time when last looked at
+    bool looked = false;
     Clock::time_point unchanged_since = Clock::now();
     bool said_waiting = false;
     auto say = [&options](const std::string& text) {
@@ -124,16 +137,18 @@ bool produce_file_once(const fs::path& target, const std::function<void(const fs
         if (fs::exists(target)) return false;
         if (take_marker(marker)) {
             if (fs::exists(target)) {  // finished between the look and the marker
-                fs::remove(marker);
+                remove_marker_of(marker, me());
                 return false;
             }
             return compute(target, marker, write, options);
         }
         std::error_code ec;
         const fs::file_time_type time = fs::last_write_time(marker, ec);
-        if (ec) continue;  // the holder just finished or gave up: look again
-        if (!seen || *seen != time) {
+        if (ec == std::errc::no_such_file_or_directory) continue;  // the holder just finished or gave up
+        if (ec) throw Error(marker.string(), "cannot read the marker: " + ec.message());
+        if (!looked || seen != time) {
             seen = time;
+            looked = true;
             unchanged_since = Clock::now();
         }
         const std::optional<Holder> holder = read_holder(marker);
@@ -141,18 +156,15 @@ bool produce_file_once(const fs::path& target, const std::function<void(const fs
         // Times are compared on this machine's clock only (the marker's time is just
         // watched for change), so clocks that differ between nodes do not matter.
         const bool not_refreshed = Clock::now() - unchanged_since > options.stale_after;
-        if (holder_gone_here || not_refreshed) {
-            say(target.string() + ": its holder " + (holder ? holder->host + " " + std::to_string(holder->pid) : "?") +
-                " is gone; computing it here");
-            // Two waiters may both find the same dead holder; both then race for a new
-            // marker and one wins. Rarely both compute: the rename makes that harmless.
-            fs::remove(marker, ec);
-            seen.reset();
+        if (holder && (holder_gone_here || not_refreshed)) {
+            say(target.string() + ": its holder, " + holder->text() + ", is gone; computing it here");
+            remove_marker_of(marker, *holder);
+            remove_leftovers(target, *holder);
+            looked = false;
             continue;
         }
         if (!said_waiting) {
-            say(target.string() + " is being computed by " +
-                (holder ? "process " + std::to_string(holder->pid) + " on " + holder->host : "another process") +
+            say(target.string() + " is being computed by " + (holder ? holder->text() : "another process") +
                 "; waiting for it");
             said_waiting = true;
         }

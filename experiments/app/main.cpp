@@ -163,7 +163,8 @@ int main(int argc, char** argv) {
     std::vector<std::string> extra_axes;
     experiment->add_option("--axis", extra_axes,
                            "a declared experiment swept along one more axis, SETTING=V1,V2,... (repeatable); an axis "
-                           "of the experiment on that setting takes these values instead");
+                           "of the experiment on that setting takes these values instead")
+        ->allow_extra_args(false);
     bool resume = false;
     experiment->add_flag("--resume", resume,
                          "skip experiments whose results/NAME holds a finished run of this build with the same "

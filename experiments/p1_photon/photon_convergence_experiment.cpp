@@ -60,23 +60,21 @@ struct NoisyReference {
 // The second half's seed: independent of the first half's and of the run's.
 uint64_t second_half_seed(uint64_t run_seed) { return reference_seed(run_seed) ^ 0x48414c46ull; }
 
+// Samples per pixel of each reference half, for the task's plan and scene.
+int reference_spp_per_half(const ProbeCall& call) {
+    return call.setting<json>("reference_spp_per_half").at(call.ctx.quick ? "quick" : "full").at(call.task.scene).get<int>();
+}
+
 // A task's reference halves A and B, jittered, at the scene camera and the run's size:
 // A on the reference's seed, B on second_half_seed. None when the scene cannot be loaded
 // (the probe notes the skip).
 std::vector<ReferenceView> point_references(const ProbeCall& call) {
-    const Scene* scene = nullptr;
-    try {
-        scene = &call.scene();
-    } catch (const Error&) {
-        return {};
-    }
+    const Scene* scene = call.scene_or_null();
+    if (!scene) return {};
     if (!scene->camera) throw Error("pm-convergence", call.task.scene + " has no camera");
     const SceneCamera& c = *scene->camera;
     const EyeCamera camera = EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, call.size, call.size);
-    const int spp_per_half = call.setting<json>("reference_spp_per_half")
-                                 .at(call.ctx.quick ? "quick" : "full")
-                                 .at(call.task.scene)
-                                 .get<int>();
+    const int spp_per_half = reference_spp_per_half(call);
     return {ReferenceView{scene, camera, spp_per_half, /*jitter=*/true},
             ReferenceView{scene, camera, spp_per_half, /*jitter=*/true, second_half_seed(call.ctx.seed)}};
 }
@@ -323,9 +321,8 @@ std::vector<json> points(const Curves& c) {
 
 Experiment photon_convergence_experiment() {
     add_probe("pm-convergence", point_probe, point_references, [](const ProbeCall& call) {
-        const int spp = call.setting<json>("reference_spp_per_half").at(call.ctx.quick ? "quick" : "full").at(call.task.scene);
         return "pm-convergence halves: " + call.task.scene + " " + std::to_string(call.size) + "px " +
-               std::to_string(spp) + "spp";
+               std::to_string(reference_spp_per_half(call)) + "spp";
     });
     add_reducer("pm-convergence", reduce);
     return declared_experiment({

@@ -331,12 +331,8 @@ std::vector<std::string> write_images(const ProbeCall& call, const std::string& 
 // The reference the images are compared with, at the scene camera (none when the scene
 // cannot be loaded; the probe then fails on loading it).
 std::vector<ReferenceView> fig8_references(const ProbeCall& call) {
-    const Scene* scene = nullptr;
-    try {
-        scene = &call.scene();
-    } catch (const Error&) {
-        return {};
-    }
+    const Scene* scene = call.scene_or_null();
+    if (!scene) return {};
     return {ReferenceView{scene, scene_camera(*scene, call.size), call.reference_spp}};
 }
 

@@ -39,20 +39,10 @@ int side_of(const json& photons) { return int(std::lround(std::sqrt(photons.get<
 std::string label_of(const std::string& scene) { return scene == "cornell" ? "cornell" : "conference (Office)"; }
 bool is_office(const std::string& scene) { return scene != "cornell"; }
 
-// The task's scene, or null with `why` when it cannot be loaded (a missing asset).
-const Scene* loaded_scene(const ProbeCall& call, std::string& why) {
-    try {
-        return &call.scene();
-    } catch (const Error& e) {
-        why = e.what();
-        return nullptr;
-    }
-}
-
 // The task's scene, or a note saying why it is skipped.
 const Scene* scene_or_note(const ProbeCall& call, ProbeOutput& out) {
     std::string why;
-    const Scene* scene = loaded_scene(call, why);
+    const Scene* scene = call.scene_or_null(&why);
     if (!scene) {
         out.notes.push_back("Office scene skipped: " + why);
         call.ctx.say("skipping " + call.task.scene + ": " + why);
@@ -291,7 +281,7 @@ SpecAxis table5_axis() {
 // The final renders' reference: the left eye of the stereo pair (none without the scene).
 std::vector<ReferenceView> final_references(const ProbeCall& call) {
     std::string why;
-    const Scene* scene = loaded_scene(call, why);
+    const Scene* scene = call.scene_or_null(&why);
     if (!scene) return {};
     return {ReferenceView{scene, stereo_views(vive_rig(*scene, call.ctx.quick)).views[0], reference_spp_for(call)}};
 }
@@ -355,7 +345,7 @@ ExperimentOutput reduce_final(const SpecReduction& r) {
 // The left eye's reference (none without the scene); the probe renders that eye.
 std::vector<ReferenceView> foveated_references(const ProbeCall& call) {
     std::string why;
-    const Scene* scene = loaded_scene(call, why);
+    const Scene* scene = call.scene_or_null(&why);
     if (!scene) return {};
     return {ReferenceView{scene, vive_rig(*scene, call.ctx.quick).eye(Eye::Left), reference_spp_for(call)}};
 }

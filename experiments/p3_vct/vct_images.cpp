@@ -41,10 +41,14 @@ struct Reference {
     Film film;
     std::vector<std::string> files;
 };
+// Which tasks share image_reference's reference: its scene, camera, size and samples.
+std::string image_group(const ProbeCall& call) {
+    return "vct reference: " + scene_of(call) + " " + call.variant.settings.value("camera", nlohmann::json()).dump() +
+           " " + std::to_string(call.size) + "px " + std::to_string(call.reference_spp) + "spp";
+}
+
 const Reference& reference_of(const ProbeCall& call) {
-    const std::string key = "vct reference:" + scene_of(call) + " " + std::to_string(call.size) + " " +
-                            std::to_string(call.reference_spp);
-    return call.cache.get<Reference>(key, [&] {
+    return call.cache.get<Reference>(image_group(call), [&] {
         Reference r;
         r.film = path_reference(call.ctx, image_reference(call).at(0), r.files);
         return r;
@@ -122,13 +126,8 @@ nlohmann::json buddha(bool specular) {
 }  // namespace
 
 void register_images(ExperimentRegistry& registry) {
-    // The groups mirror reference_of's key: tasks of one scene, size and samples share it.
-    const auto image_group = [](const ProbeCall& call) {
-        return "vct reference: " + scene_of(call) + " " + std::to_string(call.size) + "px " +
-               std::to_string(call.reference_spp) + "spp";
-    };
     add_probe("vct-reference-image", reference_image_probe, image_reference, image_group);
-    add_probe("vct-image", vct_image_probe, vct_image_references, [image_group](const ProbeCall& call) {
+    add_probe("vct-image", vct_image_probe, vct_image_references, [](const ProbeCall& call) {
         return call.setting<bool>("against_reference", false) ? image_group(call) : std::string();
     });
     add_reducer("vct-fig11", [](const SpecReduction& r) {

@@ -154,7 +154,8 @@ nlohmann::json leak_vct(const std::string& structure, bool clip_plane) {
 void register_stability(ExperimentRegistry& registry) {
     add_probe("vct-flicker", flicker_probe);
     add_probe("vct-leak", leak_probe, leak_references, [](const ProbeCall& call) {
-        return call.variant.settings.contains("vct") ? std::string() : "vct-leak/" + std::to_string(call.task.id);
+        return call.variant.settings.contains("vct") ? std::string()
+                                                     : call.spec.name + "/" + std::to_string(call.task.id);
     });
     add_reducer("vct-stability", stability);
     registry.add(declared_experiment({

@@ -102,7 +102,8 @@ fs::path staging_directory(const fs::path& results_root, const std::string& name
     return results_root / ("." + name + ".partial");
 }
 
-std::string reason_to_rerun(const fs::path& experiment_dir, bool quick, uint64_t seed, int threads) {
+std::string reason_to_rerun(const Experiment& experiment, const fs::path& experiment_dir, bool quick, uint64_t seed,
+                            int threads) {
     const fs::path file = experiment_dir / "results.json";
     std::ifstream in(file);
     if (!in) return "no finished run";
@@ -116,6 +117,11 @@ std::string reason_to_rerun(const fs::path& experiment_dir, bool quick, uint64_t
     if (doc.contains("config") && doc["config"].contains("effective") &&
         !doc["config"]["effective"].value("tasks_missing", nlohmann::json::array()).empty())
         return "merged from some of its tasks only";
+    if (experiment.spec && doc.contains("config")) {
+        nlohmann::json spec = doc["config"];
+        spec.erase("effective");
+        if (spec != experiment.spec->to_json()) return "finished with another spec (other --axis values, say)";
+    }
     return "";
 }
 
@@ -133,7 +139,7 @@ int run_experiment_batch(const ExperimentBatch& batch, std::ostream& out, std::o
         std::error_code ec;
         fs::remove_all(staging, ec);  // left by an interrupted batch
         if (batch.resume) {
-            const std::string reason = reason_to_rerun(final_dir, batch.quick, batch.seed, batch.threads);
+            const std::string reason = reason_to_rerun(*e, final_dir, batch.quick, batch.seed, batch.threads);
             if (reason.empty()) {
                 out << "experiment " << e->name << ": kept (finished earlier; --resume)" << std::endl;
                 kept.push_back(e->name);

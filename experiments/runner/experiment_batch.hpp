@@ -37,7 +37,8 @@ void publish_directory(const std::filesystem::path& staging, const std::filesyst
 std::filesystem::path staging_directory(const std::filesystem::path& results_root, const std::string& name);
 
 // Why results/NAME cannot be kept by --resume ("" when it can): no results.json, or one
-// from another revision, quick flag, seed or thread count.
-std::string reason_to_rerun(const std::filesystem::path& experiment_dir, bool quick, uint64_t seed, int threads);
+// from another revision, quick flag, seed, thread count or (a declared one) spec.
+std::string reason_to_rerun(const Experiment& experiment, const std::filesystem::path& experiment_dir, bool quick,
+                            uint64_t seed, int threads);
 
 }  // namespace gilab

@@ -221,10 +221,15 @@ ExperimentSpec with_extra_axes(ExperimentSpec spec, const std::vector<std::strin
         if (eq == 0 || eq == std::string::npos || eq + 1 == text.size())
             throw Error("--axis " + text, "give SETTING=V1,V2,… (e.g. radius=0.05,0.1)");
         const std::string setting = text.substr(0, eq);
+        const std::string list_text = text.substr(eq + 1);
+        if (list_text.back() == ',') throw Error("--axis " + text, "an empty value");
         std::vector<nlohmann::json> values;
-        std::stringstream list(text.substr(eq + 1));
+        std::stringstream list(list_text);
         for (std::string value; std::getline(list, value, ',');) {
             if (value.empty()) throw Error("--axis " + text, "an empty value");
+            // A comma separates values, so a value cannot be a list or an object.
+            if (value.front() == '[' || value.front() == '{')
+                throw Error("--axis " + text, "values are numbers, true/false or words, not lists or objects");
             const nlohmann::json parsed = nlohmann::json::parse(value, nullptr, /*allow_exceptions=*/false);
             values.push_back(parsed.is_discarded() ? nlohmann::json(value) : parsed);
         }
@@ -240,7 +245,15 @@ ExperimentSpec with_extra_axes(ExperimentSpec spec, const std::vector<std::strin
                                                   "rows); it cannot be swept on its own");
             }
         }
-        if (!replaced) spec.axes.push_back({setting, values, values});
+        if (!replaced) {
+            // A technique's schema checks the setting (check() below); a probe takes
+            // only the settings its variant gives.
+            for (const SpecVariant& v : spec.variants)
+                if (v.is_probe() && !v.settings.contains(setting))
+                    throw Error("--axis " + text, "variant '" + v.name + "' of experiment '" + spec.name + "' (probe '" +
+                                                      v.probe + "') has no setting '" + setting + "' to sweep");
+            spec.axes.push_back({setting, values, values});
+        }
     }
     spec.check();
     return spec;

@@ -1,8 +1,8 @@
 #include "experiments/runner/path_reference.hpp"
 
-#include <random>
 #include "core/util/error.hpp"
 #include "core/util/produce_once.hpp"
+#include "core/util/temporary_path.hpp"
 #include "core/image/image_io.hpp"
 #include "core/scene/scene_hash.hpp"
 #include "core/util/settings.hpp"
@@ -73,12 +73,16 @@ std::optional<Film> read_stored(const ExperimentContext& ctx, const fs::path& fi
 void place_in_experiment(const ExperimentContext& ctx, const fs::path& from, const std::string& name) {
     const fs::path here = ctx.output_dir / name;
     if (fs::exists(here)) return;
-    fs::path temporary = here;
-    temporary += ".link." + std::to_string(std::random_device{}());
+    const fs::path temporary = temporary_sibling(here);
     std::error_code ec;
     fs::create_hard_link(from, temporary, ec);
-    if (ec) fs::copy_file(from, temporary, fs::copy_options::overwrite_existing);
-    fs::rename(temporary, here);
+    try {
+        if (ec) fs::copy_file(from, temporary);
+        fs::rename(temporary, here);
+    } catch (const fs::filesystem_error& e) {
+        fs::remove(temporary, ec);
+        throw Error(here.string(), std::string("cannot place the reference here: ") + e.what());
+    }
 }
 
 }  // namespace

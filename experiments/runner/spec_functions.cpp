@@ -24,6 +24,15 @@ const Scene& ProbeCall::scene() const {
     return cache.get<Scene>("scene:" + task.scene, [&] { return open_scene(task.scene, ctx.assets).scene; });
 }
 
+const Scene* ProbeCall::scene_or_null(std::string* why) const {
+    try {
+        return &scene();
+    } catch (const Error& e) {
+        if (why) *why = e.what();
+        return nullptr;
+    }
+}
+
 const nlohmann::json* TaskResult::row(const std::string& variant) const {
     for (const nlohmann::json& r : rows)
         if (r.value("variant", std::string()) == variant) return &r;

@@ -45,6 +45,9 @@ struct ProbeCall {
     int size = 0, frames = 0, reference_spp = 0;
     TaskCache& cache;
     const Scene& scene() const;  // the task's scene by its `gilab render` name, loaded once per run
+    // The same, or null when it cannot be loaded (a shared asset not installed), saying
+    // why in `why` when given.
+    const Scene* scene_or_null(std::string* why = nullptr) const;
     // The setting `key` of the variant, or `fallback` when the variant does not give it.
     template <class T>
     T setting(const std::string& key, T fallback) const {

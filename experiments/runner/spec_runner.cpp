@@ -1,10 +1,13 @@
 #include "experiments/runner/spec_runner.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <optional>
 #include <set>
+#include <thread>
 #include "core/image/image_io.hpp"
 #include "core/image/image_metrics.hpp"
 #include "core/util/error.hpp"
@@ -183,6 +186,17 @@ std::vector<nlohmann::json> run_technique_variants(const ExperimentSpec& spec, c
     return rows;
 }
 
+// For tests of killed tasks: with $GILAB_TASK_DELAY=NAME/ID:SECONDS the task waits that
+// long after its work, before its result is written, so a kill then loses the work done.
+void wait_if_asked(const ExperimentSpec& spec, const SpecTask& task, const ExperimentContext& ctx) {
+    const char* delay = std::getenv("GILAB_TASK_DELAY");
+    const std::string key = spec.name + "/" + std::to_string(task.id) + ":";
+    if (!delay || std::string(delay).rfind(key, 0) != 0) return;
+    const double seconds = std::atof(delay + key.size());
+    ctx.say("waiting " + std::to_string(seconds) + " s before writing the result ($GILAB_TASK_DELAY)");
+    std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+}
+
 // Task `task`: run its variants, write its file.
 nlohmann::json run_planned_task(const ExperimentSpec& spec, const SpecTask& task, TaskCache& cache,
                                 const ExperimentContext& ctx) {
@@ -231,6 +245,7 @@ nlohmann::json run_planned_task(const ExperimentSpec& spec, const SpecTask& task
     result["threads"] = ctx.threads > 0 ? ctx.threads : int(machine["tbb_threads"]);
     result["machine"] = machine.value("cpu", std::string("unknown CPU"));
     const fs::path file = spec_task_file(ctx.output_dir, task.id, ctx.quick);
+    wait_if_asked(spec, task, ctx);
     fs::create_directories(file.parent_path());
     write_file_atomically(file, result.dump(2) + "\n");
     return result;
@@ -281,12 +296,15 @@ fs::path spec_task_file(const fs::path& output_dir, int task_id, bool quick) {
     return output_dir / "tasks" / (quick ? "quick" : "full") / (std::to_string(task_id) + ".json");
 }
 
-bool holds_task_result(const ExperimentSpec& spec, const SpecTask& task, bool quick, uint64_t seed, const fs::path& file) {
+std::optional<nlohmann::json> read_task_result(const ExperimentSpec& spec, const SpecTask& task, bool quick,
+                                               uint64_t seed, const fs::path& file) {
     std::ifstream in(file);
-    if (!in) return false;
-    const nlohmann::json result = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-    return !result.is_discarded() && result.is_object() &&
-           identity_mismatch(result, task_identity(spec, task, quick, seed), quick).empty();
+    if (!in) return std::nullopt;
+    nlohmann::json result = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    if (result.is_discarded() || !result.is_object() ||
+        !identity_mismatch(result, task_identity(spec, task, quick, seed), quick).empty())
+        return std::nullopt;
+    return result;
 }
 
 nlohmann::json run_spec_task(const ExperimentSpec& spec, int task_id, const ExperimentContext& ctx) {

@@ -32,10 +32,10 @@ int render_task_references(const ExperimentSpec& spec, int task_id, const Experi
 // technique variants' scene, size and samples, or NAME/ID for a probe's own references.
 std::string reference_group(const ExperimentSpec& spec, const SpecTask& task, bool quick);
 
-// Whether `file` holds task `task`'s result for this plan (quick, seed, spec): false when
-// it is missing, unreadable or written for another plan.
-bool holds_task_result(const ExperimentSpec& spec, const SpecTask& task, bool quick, uint64_t seed,
-                       const std::filesystem::path& file);
+// Task `task`'s result in `file` for this plan (quick, seed, spec), or nothing when the
+// file is missing, unreadable or written for another plan.
+std::optional<nlohmann::json> read_task_result(const ExperimentSpec& spec, const SpecTask& task, bool quick,
+                                               uint64_t seed, const std::filesystem::path& file);
 
 // Reduces the task files in ctx.output_dir/tasks into the experiment's tables. Refuses
 // a task file written for another plan (another --quick, --seed, spec or task order)

@@ -1,9 +1,7 @@
 #include "experiments/runner/task_command.hpp"
 
 #include <charconv>
-#include <chrono>
 #include <cstdlib>
-#include <thread>
 #include "core/util/error.hpp"
 #include "experiments/runner/experiment.hpp"
 #include "experiments/runner/path_reference.hpp"
@@ -66,16 +64,10 @@ int run_task_command(const TaskCommand& c, std::ostream& out) {
     }
     if (c.verb == "run-task") {
         const int id = task_id(c.arguments[1]);
-        // For tests of failure handling (sweeps, job arrays): a task that fails on demand,
-        // and one that takes long enough to be killed or requeued while it runs.
-        const std::string key = e.name + "/" + std::to_string(id);
-        if (const char* fail = std::getenv("GILAB_FAIL_TASK"); fail && std::string(fail) == key)
+        // For tests of failure handling (sweeps, job arrays): a task that fails on demand.
+        // ($GILAB_TASK_DELAY, a task to kill while it runs, is spec_runner's.)
+        if (const char* fail = std::getenv("GILAB_FAIL_TASK"); fail && std::string(fail) == e.name + "/" + std::to_string(id))
             throw Error(e.name + " task " + std::to_string(id), "failed on purpose ($GILAB_FAIL_TASK=" + std::string(fail) + ")");
-        if (const char* delay = std::getenv("GILAB_TASK_DELAY"); delay && std::string(delay).rfind(key + ":", 0) == 0) {
-            const double seconds = std::atof(delay + key.size() + 1);
-            out << "waiting " << seconds << " s first ($GILAB_TASK_DELAY)" << std::endl;
-            std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
-        }
         run_spec_task(*e.spec, id, ctx);
         out << "wrote " << spec_task_file(ctx.output_dir, id, ctx.quick).string() << "\n";
         return 0;

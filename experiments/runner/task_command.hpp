@@ -34,7 +34,8 @@ Experiment declared_experiment_with_axes(const std::string& name, const std::vec
 // path-traced references).
 // run-task: runs task ID and writes RESULTS/NAME/tasks/{full|quick}/ID.json. For tests
 // of failed and killed tasks: with $GILAB_FAIL_TASK=NAME/ID it fails instead, writing
-// nothing; with $GILAB_TASK_DELAY=NAME/ID:SECONDS it waits that long first.
+// nothing; with $GILAB_TASK_DELAY=NAME/ID:SECONDS it waits that long after its work,
+// before writing its result (spec_runner.cpp).
 // references: renders the path-traced references task ID needs into RESULTS/.references
 // (those there already are kept), so the tasks that need them find them.
 // merge: writes RESULTS/NAME/results.csv, results.json and table.md from the tasks there.

@@ -19,7 +19,8 @@ namespace gilab {
 namespace fs = std::filesystem;
 
 const SweepExperiment& Sweep::experiment(const std::string& name) const {
-    const std::string key = name + (quick ? " quick" : " full");
+    std::string key = name + (quick ? " quick" : " full");
+    for (const std::string& axis : axes) key += " --axis " + axis;
     auto it = made->find(key);
     if (it == made->end()) {
         SweepExperiment e{declared_experiment_with_axes(name, axes), {}};
@@ -78,18 +79,22 @@ fs::path task_result_file(const Sweep& sweep, const SweepTask& task) {
     return spec_task_file(sweep.results_root / task.experiment, task.id, sweep.quick);
 }
 
-bool task_done(const Sweep& sweep, const SweepTask& task) {
+namespace {
+
+std::optional<nlohmann::json> task_result(const Sweep& sweep, const SweepTask& task) {
     const SweepExperiment& e = sweep.experiment(task.experiment);
-    return holds_task_result(*e.experiment.spec, e.plan.at(size_t(task.id)), sweep.quick, sweep.seed,
-                             task_result_file(sweep, task));
+    return read_task_result(*e.experiment.spec, e.plan.at(size_t(task.id)), sweep.quick, sweep.seed,
+                            task_result_file(sweep, task));
 }
 
+}  // namespace
+
+bool task_done(const Sweep& sweep, const SweepTask& task) { return task_result(sweep, task).has_value(); }
+
 std::optional<double> task_seconds(const Sweep& sweep, const SweepTask& task) {
-    if (!task_done(sweep, task)) return std::nullopt;
-    std::ifstream in(task_result_file(sweep, task));
-    const nlohmann::json result = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-    if (result.is_discarded() || !result.contains("seconds") || !result["seconds"].is_number()) return std::nullopt;
-    return result["seconds"].get<double>();
+    const std::optional<nlohmann::json> result = task_result(sweep, task);
+    if (!result || !result->contains("seconds") || !(*result)["seconds"].is_number()) return std::nullopt;
+    return (*result)["seconds"].get<double>();
 }
 
 double wall_seconds_on(std::vector<double> seconds, int slots) {

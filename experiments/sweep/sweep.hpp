@@ -41,7 +41,7 @@ struct Sweep {
     std::string on = "local";              // local | slurm
     nlohmann::json slurm = nlohmann::json::object();        // the Slurm options (sweep_slurm.hpp)
     nlohmann::json submissions = nlohmann::json::array();   // one object per submitted round
-    // experiment()'s, by name and plan size; shared by copies of the sweep.
+    // experiment()'s, by name, quick or full, and axes; shared by copies of the sweep.
     mutable std::shared_ptr<std::map<std::string, SweepExperiment>> made = std::make_shared<std::map<std::string, SweepExperiment>>();
 
     std::filesystem::path directory() const { return results_root / ".sweep"; }

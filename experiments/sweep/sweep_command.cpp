@@ -17,7 +17,8 @@ CLI::App* add_sweep_subcommand(CLI::App& app, SweepCommand& c) {
     sweep->add_option("--axis", c.axes,
                       "sweep every named experiment along one more axis, SETTING=V1,V2,... (repeatable); an axis of "
                       "the experiment on that setting takes these values instead. Use a --results of its own: the "
-                      "tasks are numbered anew");
+                      "tasks are numbered anew")
+        ->allow_extra_args(false);
     sweep->add_option("--results", c.results, "results root directory (on a cluster: on the shared filesystem)")
         ->capture_default_str();
     sweep->add_option("--seed", c.seed, "random seed")->capture_default_str();

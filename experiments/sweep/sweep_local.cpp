@@ -128,10 +128,15 @@ int run_sweep_locally(const Sweep& sweep, const LocalSweepOptions& options, std:
                               t.experiment + " task " + std::to_string(t.id) + "'s references"});
     }
     if (!references.empty()) {
+        // The cores shared among the reference processes alone: fewer groups than task
+        // processes get more threads each.
+        const int reference_jobs = std::min<int>(jobs, int(references.size()));
+        const int reference_threads = options.threads > 0 ? options.threads : std::max(1, cores / reference_jobs);
         out << "references first: " << references.size() << " reference group(s) into "
-            << (sweep.results_root / ".references").string() << std::endl;
-        const std::vector<std::string> failed =
-            run_all(sweep, references, jobs, threads, [](const SweepProcess&) { return true; }, out);
+            << (sweep.results_root / ".references").string() << ", " << reference_jobs << " at a time with "
+            << reference_threads << " thread(s) each" << std::endl;
+        const std::vector<std::string> failed = run_all(sweep, references, reference_jobs, reference_threads,
+                                                        [](const SweepProcess&) { return true; }, out);
         if (!failed.empty())
             err << "gilab: sweep: rendering references failed for " << listed(failed)
                 << "; the tasks that need them try again themselves" << std::endl;

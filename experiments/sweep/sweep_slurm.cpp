@@ -205,15 +205,18 @@ std::string default_time_limit(const Sweep& sweep, const std::vector<SweepTask>&
 void submit_sweep_round(Sweep& sweep, const std::vector<SweepTask>& tasks, const SlurmSweepOptions& given,
                         std::ostream& out) {
     given.check();
+    require_one_word(sweep.results_root.string(), "--results");
+    require_one_word(sweep.gilab.string(), "the gilab program's path");
+    require_one_word(sweep.assets, "--assets");
+    for (const std::string& axis : sweep.axes) require_one_word(axis, "--axis");
+    // The tasks' default limit comes from measured task times; the references' renders
+    // are not measured there, so their array keeps the limit given (or the cluster's).
     SlurmSweepOptions options = given;
     if (options.time.empty() && !tasks.empty()) {
         std::string why;
         options.time = default_time_limit(sweep, tasks, why);
         out << why << std::endl;
     }
-    require_one_word(sweep.results_root.string(), "--results");
-    require_one_word(sweep.gilab.string(), "the gilab program's path");
-    require_one_word(sweep.assets, "--assets");
     if (tasks.empty()) throw Error("sweep", "no task to submit");
     if (!options.dry_run && !program_on_path("sbatch"))
         throw Error("sbatch", "not found on PATH, so this machine cannot submit Slurm jobs. On a cluster, run "
@@ -230,7 +233,7 @@ void submit_sweep_round(Sweep& sweep, const std::vector<SweepTask>& tasks, const
     if (!references.empty()) {
         write_file_atomically(list_file(sweep, round, ArrayKind::References), task_list_text(sweep, references));
         write_file_atomically(references_file,
-                              array_script(sweep, options, references.size(), round, ArrayKind::References));
+                              array_script(sweep, given, references.size(), round, ArrayKind::References));
     }
     write_file_atomically(list_file(sweep, round, ArrayKind::Tasks), task_list_text(sweep, tasks));
     write_file_atomically(array_file, array_script(sweep, options, tasks.size(), round, ArrayKind::Tasks));

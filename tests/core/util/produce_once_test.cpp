@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
@@ -48,34 +49,50 @@ ProduceOnceOptions fast() {
     return o;
 }
 
-TEST(ProduceOnce, ManyAskingAtOnceComputeOnce) {
+TEST(ProduceOnce, ManyProcessesAskingAtOnceComputeOnce) {
     const fs::path dir = test::temp_dir("produce_once_many");
     const fs::path target = dir / "reference.txt";
-    std::atomic<int> computed{0}, wrote{0};
-    std::vector<std::thread> askers;
-    for (int i = 0; i < 4; ++i)
-        askers.emplace_back([&] {
+    const fs::path log = test::temp_dir("produce_once_many_log") / "computations";
+    // Four processes, as tasks on several nodes would be; each computation adds a line.
+    std::vector<pid_t> children;
+    for (int i = 0; i < 4; ++i) {
+        const pid_t child = fork();
+        if (child == 0) {
             const bool mine = produce_file_once(target, [&](const fs::path& tmp) {
-                ++computed;
+                std::ofstream(log, std::ios::app) << getpid() << "\n";
                 std::this_thread::sleep_for(300ms);
                 write_text(tmp, "image");
             }, fast());
-            if (mine) ++wrote;
-        });
-    for (std::thread& t : askers) t.join();
-    EXPECT_EQ(computed.load(), 1);
-    EXPECT_EQ(wrote.load(), 1);
+            _exit(mine ? 10 : 0);
+        }
+        children.push_back(child);
+    }
+    int wrote = 0;
+    for (pid_t child : children) {
+        int status = 0;
+        waitpid(child, &status, 0);
+        ASSERT_TRUE(WIFEXITED(status));
+        wrote += WEXITSTATUS(status) == 10;
+    }
+    EXPECT_EQ(wrote, 1);
+    std::ifstream lines(log);
+    EXPECT_EQ(std::count(std::istreambuf_iterator<char>(lines), {}, '\n'), 1);
     EXPECT_EQ(contents(target), "image");
     EXPECT_EQ(files_in(dir), 1u) << "the marker and the temporary are gone";
     // There already: nothing computed.
-    EXPECT_FALSE(produce_file_once(target, [&](const fs::path&) { ++computed; }, fast()));
-    EXPECT_EQ(computed.load(), 1);
+    bool computed = false;
+    EXPECT_FALSE(produce_file_once(target, [&](const fs::path&) { computed = true; }, fast()));
+    EXPECT_FALSE(computed);
 }
 
 TEST(ProduceOnce, HolderThatEndedOnThisHostIsTakenOverAtOnce) {
     const fs::path dir = test::temp_dir("produce_once_dead_here");
     const fs::path target = dir / "reference.txt";
-    write_text(dir / "reference.txt.computing", this_host() + " " + std::to_string(ended_process()) + "\n");
+    const pid_t dead = ended_process();
+    write_text(dir / "reference.txt.computing", this_host() + " " + std::to_string(dead) + "\n");
+    // What it was writing when it died goes too.
+    const fs::path leftover = dir / (".reference.txt.tmp." + this_host() + "." + std::to_string(dead) + ".0");
+    write_text(leftover, "half");
     ProduceOnceOptions o = fast();
     o.stale_after = 3600s;  // so only the process check can find it gone
     std::string said;
@@ -84,6 +101,7 @@ TEST(ProduceOnce, HolderThatEndedOnThisHostIsTakenOverAtOnce) {
     EXPECT_EQ(contents(target), "mine");
     EXPECT_NE(said.find("is gone"), std::string::npos) << said;
     EXPECT_FALSE(fs::exists(dir / "reference.txt.computing"));
+    EXPECT_FALSE(fs::exists(leftover));
 }
 
 TEST(ProduceOnce, MarkerFromAnotherHostNotRefreshedIsTakenOver) {
@@ -98,7 +116,8 @@ TEST(ProduceOnce, LivingHolderIsWaitedForLongerThanTheStaleTime) {
     const fs::path dir = test::temp_dir("produce_once_alive");
     const fs::path target = dir / "reference.txt";
     std::atomic<int> computed{0};
-    // The holder works 2.5 stale times; its heartbeat keeps the waiter from taking over.
+    // The holder works 2.5 stale times; its heartbeat (every 50 ms) keeps the waiter from
+    // taking over.
     std::thread holder([&] {
         produce_file_once(target, [&](const fs::path& tmp) {
             ++computed;

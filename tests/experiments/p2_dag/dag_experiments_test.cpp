@@ -118,9 +118,10 @@ TEST_F(DagExperimentsTest, Table1CountsAreConsistent) {
         ASSERT_EQ(merged.tables[t].rows.size(), out.tables[t].rows.size());
         for (size_t r = 0; r < out.tables[t].rows.size(); ++r)
             for (const std::string& column : out.tables[t].columns)
-                if (column.find("_ms") == std::string::npos && column.find("time") == std::string::npos)
+                if (column.find("_ms") == std::string::npos && column.find("time") == std::string::npos) {
                     EXPECT_EQ(merged.tables[t].rows[r].at(column), out.tables[t].rows[r].at(column))
                         << "table " << t << " row " << r << " " << column;
+                }
     }
     for (const json& row : out.tables[1].rows) {
         const double voxels = num(row, "voxels");

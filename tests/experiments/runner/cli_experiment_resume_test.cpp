@@ -161,6 +161,16 @@ TEST(ExperimentResume, KilledRerunKeepsThePreviousResultsAndResumeChecksTheSeed)
     EXPECT_EQ(code, 0) << output;
     EXPECT_TRUE(contains(output, "vct-table1: running again (finished with another seed)")) << output;
     EXPECT_NE(read_file(results / "dag-fig15" / "results.json"), previous);
+
+    // A run along other axis values is another run: --resume keeps only its own.
+    const std::vector<std::string> swept = {"--threads", "2", "experiment", "dag-fig15", "--quick", "--seed", "7",
+                                            "--results", results.string(), "--resume"};
+    const auto [kept_code, kept] = finish(start_gilab(swept));
+    EXPECT_EQ(kept_code, 0) << kept;
+    EXPECT_TRUE(contains(kept, "dag-fig15: kept")) << kept;
+    const auto [axis_code, axis_output] = finish(start_gilab(with(swept, {"--axis", "resolution=32"})));
+    EXPECT_EQ(axis_code, 0) << axis_output;
+    EXPECT_TRUE(contains(axis_output, "dag-fig15: running again (finished with another spec")) << axis_output;
 }
 
 }  // namespace

@@ -30,8 +30,8 @@ jobs="$(job_ids "$out")"
 IFS=, read -r references_job array_job merge_job <<<"$jobs"
 [ -n "$merge_job" ] || fail "no references job (pm-radius-sweep compares against a reference)"
 log="$work/slurm/.sweep/logs/array.1_0.out"
-for _ in $(seq 120); do grep -qs "waiting 6 s first" "$log" && break; sleep 0.5; done
-grep -qs "waiting 6 s first" "$log" || fail "$requeued did not start within 60 s"
+for _ in $(seq 120); do grep -qs "before writing the result" "$log" && break; sleep 0.5; done
+grep -qs "before writing the result" "$log" || fail "$requeued did not finish its work within 60 s"
 scontrol requeue "${array_job}_0"
 sleep 1
 [ ! -f "$work/slurm/core-rays/tasks/quick/1.json" ] || fail "the requeued task left a result"
