@@ -10,6 +10,7 @@
 #include "core/util/parallel.hpp"
 #include "experiments/runner/experiment.hpp"
 #include "experiments/runner/experiment_batch.hpp"
+#include "experiments/runner/spec_runner.hpp"
 #include "experiments/runner/task_command.hpp"
 #include "python/array_helpers.hpp"
 #include "python/bindings.hpp"
@@ -103,12 +104,14 @@ void register_experiment_bindings(py::module_& m) {
                                               ? declared_experiment_named(name_or_spec.cast<std::string>())
                                               : experiment_from(name_or_spec);
             py::list tasks;
-            for (const SpecTask& t : plan_tasks(*experiment.spec, quick)) tasks.append(json_to_python(t.to_json()));
+            for (const SpecTask& t : plan_tasks(*experiment.spec, quick))
+                tasks.append(json_to_python(plan_entry(*experiment.spec, t, quick)));
             return tasks;
         },
         "experiment"_a, "quick"_a = true,
         "The tasks of a declared experiment — a name, or a spec dict as run_experiment takes — as dicts (id, scene, "
-        "axes, variants with their technique or probe and settings), as `gilab experiment plan NAME --quick` "
+        "axes, variants with their technique or probe and settings, and the reference group as 'references' when "
+        "the task compares against path-traced references), as `gilab experiment plan NAME --quick` "
         "(quick=False: the full plan, as without --quick).");
 
     m.def(

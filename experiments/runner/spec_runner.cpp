@@ -334,6 +334,12 @@ std::string reference_group(const ExperimentSpec& spec, const SpecTask& task, bo
     return groups.size() == 1 ? *groups.begin() : spec.name + "/" + std::to_string(task.id);
 }
 
+nlohmann::json plan_entry(const ExperimentSpec& spec, const SpecTask& task, bool quick) {
+    nlohmann::json entry = task.to_json();
+    if (const std::string group = reference_group(spec, task, quick); !group.empty()) entry["references"] = group;
+    return entry;
+}
+
 int render_task_references(const ExperimentSpec& spec, int task_id, const ExperimentContext& ctx) {
     const std::vector<SpecTask> tasks = plan_tasks(spec, ctx.quick);
     const SpecTask& task = planned_task(tasks, spec, task_id, ctx.quick);

@@ -37,6 +37,10 @@ std::string reference_group(const ExperimentSpec& spec, const SpecTask& task, bo
 std::optional<nlohmann::json> read_task_result(const ExperimentSpec& spec, const SpecTask& task, bool quick,
                                                uint64_t seed, const std::filesystem::path& file);
 
+// The task as the plan lists it (`gilab experiment plan`, gilab.experiment_plan): its
+// JSON, with its reference group as "references" when it has one.
+nlohmann::json plan_entry(const ExperimentSpec& spec, const SpecTask& task, bool quick);
+
 // Reduces the task files in ctx.output_dir/tasks into the experiment's tables. Refuses
 // a task file written for another plan (another --quick, --seed, spec or task order)
 // naming the file; tasks not run yet are listed in a note and in the config's

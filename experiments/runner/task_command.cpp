@@ -55,9 +55,8 @@ int run_task_command(const TaskCommand& c, std::ostream& out) {
     ctx.log = &out;
     if (c.verb == "plan") {
         for (const SpecTask& t : plan_tasks(*e.spec, c.quick)) {
-            nlohmann::json line = t.to_json();
+            nlohmann::json line = plan_entry(*e.spec, t, c.quick);
             if (const auto seconds = last_task_seconds(*e.spec, t, ctx)) line["seconds_last_run"] = *seconds;
-            if (const std::string group = reference_group(*e.spec, t, c.quick); !group.empty()) line["references"] = group;
             out << line.dump() << "\n";
         }
         return 0;
