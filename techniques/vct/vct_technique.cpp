@@ -50,7 +50,7 @@ struct Shading {
     Bounds3 bounds;  // of the voxelized geometry
 
     // Direct light leaving each face (premultiplied by its opacity).
-    VoxelRadiance direct(const VoxelInput& in, int level, const IVec3& v, float voxel) const {
+    VoxelRadiance direct(const VoxelInput& in, int level, const IVec3& v, float voxel, uint64_t& faces_lit) const {
         VoxelRadiance out{};
         Vec3 E[kFaceCount];
         for (int f = 0; f < kFaceCount; ++f) {
@@ -63,6 +63,7 @@ struct Shading {
                 Rng rng = voxel_rng(settings.seed, level, v, f);
                 float offset = std::max(1e-3f * voxel, 4.0f * ray_epsilon(fi.position));
                 E[f] = lighting.irradiance(tracer, fi.position, fi.normal, offset, rng);
+                ++faces_lit;
             }
             Vec3 L = fi.albedo * kInvPi * E[f];
             out[size_t(f)] = Vec4(L * fi.opacity, fi.opacity);
@@ -335,7 +336,9 @@ VoxelConeView VctTechnique::radiance_view() const {
 void VctTechnique::light_cascade(const std::vector<bool>& levels) {
     CascadedVoxelTexture& t = *cascade_;
     const Shading shading{scene_.tracer(), lighting_, settings_, injection_set_, voxelizer_.bounds()};
-    std::atomic<uint64_t> cones{0}, lit{0};
+    std::atomic<uint64_t> cones{0}, lit{0}, faces_lit{0};
+    uint64_t filter_cells = 0;
+    double direct_ms = 0, bounce_ms = 0, filter_ms = 0;
     // Voxels a level lights itself: its region minus the part the finer level covers.
     auto own_voxels = [&](int k) {
         std::vector<IVec3> own;
@@ -358,25 +361,38 @@ void VctTechnique::light_cascade(const std::vector<bool>& levels) {
     for (int k = 0; k < t.levels(); ++k)
         if (levels[size_t(k)]) own[size_t(k)] = own_voxels(k);
 
+    // The anisotropic filter of one level, timed and counted (cells written).
+    auto filter = [&](int k, std::vector<Vec4>& buffer) {
+        Stopwatch watch;
+        t.downsample(k, buffer);
+        filter_ms += watch.elapsed_ms();
+        filter_cells += uint64_t(t.inner_box(k).volume()) * kFaceCount;
+    };
+
     // Direct light, then filtered into the coarser levels.
     for (int k = 0; k < t.levels(); ++k) {
         if (!levels[size_t(k)]) continue;
+        Stopwatch watch;
         clear_own(k, t.direct);
         const auto& list = own[size_t(k)];
         const float voxel = float(t.voxel_size(k));
         parallel_for(list.size(), 16, [&](size_t b, size_t e) {
+            uint64_t local = 0;
             for (size_t i = b; i < e; ++i) {
-                VoxelRadiance r = shading.direct(input_of(t, k, list[i]), k, list[i], voxel);
+                VoxelRadiance r = shading.direct(input_of(t, k, list[i]), k, list[i], voxel, local);
                 for (int f = 0; f < kFaceCount; ++f) t.direct[t.index_of_voxel(f, k, list[i])] = r[size_t(f)];
             }
+            faces_lit += local;
         });
         lit += list.size();
-        t.downsample(k, t.direct);
+        direct_ms += watch.elapsed_ms();
+        filter(k, t.direct);
     }
     // Voxel bounce from the direct V-buffer.
     const VoxelConeView view = VoxelConeView::cascade(t, t.direct);
     for (int k = 0; k < t.levels(); ++k) {
         if (!levels[size_t(k)]) continue;
+        Stopwatch watch;
         clear_own(k, t.radiance);
         const auto& list = own[size_t(k)];
         const float voxel = float(t.voxel_size(k));
@@ -392,11 +408,17 @@ void VctTechnique::light_cascade(const std::vector<bool>& levels) {
             }
             cones += local;
         });
-        t.downsample(k, t.radiance);
+        bounce_ms += watch.elapsed_ms();
+        filter(k, t.radiance);
     }
     stats_.add("injection_cones_traced", double(cones.load() & 0xffffffffu));
     stats_.add("injection_cone_samples", double(cones.load() >> 32));
     stats_.set("voxels_lit", double(lit.load()));
+    stats_.set("injection_faces_lit", double(faces_lit.load()));
+    stats_.set("injection_direct_ms", direct_ms);
+    stats_.set("injection_bounce_ms", bounce_ms);
+    stats_.set("filter_ms", filter_ms);
+    stats_.set("filter_cells", double(filter_cells));
 }
 
 void VctTechnique::light_dense() {
@@ -404,14 +426,23 @@ void VctTechnique::light_dense() {
     const Shading shading{scene_.tracer(), lighting_, settings_, injection_set_, voxelizer_.bounds()};
     const float voxel = float(t.voxel_size(0));
     const auto& list = t.voxels;
+    std::atomic<uint64_t> faces_lit{0};
+    double filter_ms = 0;
+    Stopwatch watch;
     DenseMipTexture::clear_level0(t.direct);
     parallel_for(list.size(), 16, [&](size_t b, size_t e) {
+        uint64_t local = 0;
         for (size_t i = b; i < e; ++i) {
-            VoxelRadiance r = shading.direct(input_of(list[i]), 0, list[i].coord, voxel);
+            VoxelRadiance r = shading.direct(input_of(list[i]), 0, list[i].coord, voxel, local);
             for (int f = 0; f < kFaceCount; ++f) t.direct[0][t.index(0, f, list[i].coord)] = r[size_t(f)];
         }
+        faces_lit += local;
     });
+    const double direct_ms = watch.elapsed_ms();
+    watch.reset();
     t.build_mips(t.direct);
+    filter_ms += watch.elapsed_ms();
+    watch.reset();
     const VoxelConeView view = VoxelConeView::dense(t, t.direct);
     std::atomic<uint64_t> cones{0};
     DenseMipTexture::clear_level0(t.radiance);
@@ -425,10 +456,20 @@ void VctTechnique::light_dense() {
         }
         cones += local;
     });
+    const double bounce_ms = watch.elapsed_ms();
+    watch.reset();
     t.build_mips(t.radiance);
+    filter_ms += watch.elapsed_ms();
+    uint64_t filter_cells = 0;
+    for (int k = 1; k < t.level_count(); ++k) filter_cells += 2 * uint64_t(t.cells(k));
     stats_.add("injection_cones_traced", double(cones.load() & 0xffffffffu));
     stats_.add("injection_cone_samples", double(cones.load() >> 32));
     stats_.set("voxels_lit", double(list.size()));
+    stats_.set("injection_faces_lit", double(faces_lit.load()));
+    stats_.set("injection_direct_ms", direct_ms);
+    stats_.set("injection_bounce_ms", bounce_ms);
+    stats_.set("filter_ms", filter_ms);
+    stats_.set("filter_cells", double(filter_cells));
 }
 
 void VctTechnique::update_voxels(const Vec3& viewer) {
@@ -436,6 +477,7 @@ void VctTechnique::update_voxels(const Vec3& viewer) {
     ++frame_index_;
     Stopwatch update_watch;
     uint64_t revoxelized = 0, clips = 0;
+    double revoxelize_ms = 0;
     int updated_levels = 0;
     std::vector<bool> scheduled;
     if (cascade_) {
@@ -463,6 +505,7 @@ void VctTechnique::update_voxels(const Vec3& viewer) {
         }
         // Every level re-voxelized in full, or only its new border slabs and the band its
         // finer level uncovered — one pass over the triangles per level.
+        Stopwatch voxelize_watch;
         for (int k = t.levels() - 1; k >= 0; --k) {
             FragmentVoxelizeStats s = settings_.update == VctSettings::Update::Everything
                                           ? t.voxelize_own(k, voxelizer_)
@@ -470,16 +513,20 @@ void VctTechnique::update_voxels(const Vec3& viewer) {
             revoxelized += s.voxels;
             clips += s.clips;
         }
+        revoxelize_ms = voxelize_watch.elapsed_ms();
         for (bool s : scheduled) updated_levels += s;
     } else if (dense_) {
         if (settings_.update == VctSettings::Update::Everything) {
+            Stopwatch voxelize_watch;
             FragmentVoxelizeStats s = dense_->voxelize(voxelizer_);
             revoxelized = s.voxels;
             clips = s.clips;
+            revoxelize_ms = voxelize_watch.elapsed_ms();
         }
         updated_levels = 1;
     }
     stats_.set("update_ms", update_watch.elapsed_ms());
+    stats_.set("revoxelize_ms", revoxelize_ms);
     stats_.set("levels_updated", double(updated_levels));
     stats_.set("voxels_revoxelized", double(revoxelized));
     stats_.set("voxelize_clips", double(clips));
@@ -551,6 +598,7 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
 
     double primary_ms = 0, direct_ms = 0, diffuse_ms = 0, specular_ms = 0;
     std::atomic<uint64_t> cones{0};
+    std::atomic<uint64_t> diffuse_cones{0}, diffuse_samples{0}, specular_cones{0}, specular_samples{0};
     films.resize(views.views.size());
     for (size_t vi = 0; vi < views.views.size(); ++vi) {
         const EyeCamera& camera = views.views[vi];
@@ -623,7 +671,7 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
             Progress progress("vct " + (vi < views.names.size() ? views.names[vi] : std::string("mono")),
                               size_t((width + ts - 1) / ts) * size_t((height + ts - 1) / ts));
             parallel_for_tiles(width, height, ts, [&](const Tile& tile) {
-                uint64_t local = 0;
+                uint64_t local = 0, samples = 0;
                 for (int y = tile.y0; y < tile.y1; ++y)
                     for (int x = tile.x0; x < tile.x1; ++x) {
                         const size_t i = size_t(y) * size_t(width) + size_t(x);
@@ -642,11 +690,14 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
                             E += r.radiance * w;
                             occlusion += r.occlusion * w;
                             ++local;
+                            samples += uint64_t(r.samples);
                         }
                         put(indirect, i, m.albedo * kInvPi * E);
                         ao.data[i] = std::clamp(1.0f - occlusion * kInvPi, 0.0f, 1.0f);
                     }
                 cones += local;
+                diffuse_cones += local;
+                diffuse_samples += samples;
                 progress.advance();
             });
             progress.finish();
@@ -656,7 +707,7 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
         watch.reset();
         if (settings_.specular) {
             parallel_for_tiles(width, height, ts, [&](const Tile& tile) {
-                uint64_t local = 0;
+                uint64_t local = 0, samples = 0;
                 for (int y = tile.y0; y < tile.y1; ++y)
                     for (int x = tile.x0; x < tile.x1; ++x) {
                         const size_t i = size_t(y) * size_t(width) + size_t(x);
@@ -671,8 +722,11 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
                         ConeResult c = trace_cone(view, Cone{sc.apex, r, phong_cone_tan(m.phong_exponent)}, sc.options);
                         put(specular, i, m.specular * c.radiance * cos_r);
                         ++local;
+                        samples += uint64_t(c.samples);
                     }
                 cones += local;
+                specular_cones += local;
+                specular_samples += samples;
             });
         }
         specular_ms += watch.elapsed_ms();
@@ -695,6 +749,10 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
     stats_.set("specular_ms", specular_ms);
     stats_.set("total_ms", update_ms + injection_ms + primary_ms + direct_ms + diffuse_ms + specular_ms);
     stats_.set("pixel_cones_traced", double(cones.load()));
+    stats_.set("diffuse_cones_traced", double(diffuse_cones.load()));
+    stats_.set("diffuse_cone_samples", double(diffuse_samples.load()));
+    stats_.set("specular_cones_traced", double(specular_cones.load()));
+    stats_.set("specular_cone_samples", double(specular_samples.load()));
     stats_.set("structure_bytes", double(structure_bytes()));
     if (cascade_) {
         size_t occupied = 0;

@@ -99,7 +99,9 @@ public:
     const DenseMipTexture* dense() const { return dense_ ? &*dense_ : nullptr; }
     int frame_index() const { return frame_index_; }
     // Step 1 and 2 of a frame for a viewer position (render() calls it); advances the
-    // frame counter. Timings go to stats "update_ms" and "injection_ms".
+    // frame counter. Timings go to stats "update_ms" (of which "revoxelize_ms") and
+    // "injection_ms" (of which "injection_direct_ms", "injection_bounce_ms" and
+    // "filter_ms", the anisotropic filtering of both radiance buffers).
     void update_voxels(const Vec3& viewer);
     // The view of the final radiance buffer the pixels gather from.
     VoxelConeView radiance_view() const;

@@ -1,0 +1,308 @@
+// Voxel cone tracing (P3) on Sponza, phase by phase, for the cascaded voxel texture
+// (6 levels of 32³) and the dense mip texture (128³) of the same scene with the same
+// finest voxel, so each phase compares like for like:
+//  - BM_ConeMarch: 16 diffuse cones from each of 96×96 G-buffer points (primary hits of
+//    the scene camera), traced as the technique's final gather traces them;
+//  - BM_Injection: one full light injection over the occupied voxels (direct light by
+//    shadow rays, anisotropic filtering, the voxel bounce, filtering again), with its
+//    phases as counters from the technique's stats;
+//  - BM_AnisotropicFilter: the mip levels of one radiance buffer (cascades: every
+//    level's inner box from the finer level; dense: the whole chain);
+//  - BM_SampleLevel: one trilinear face-weighted sample (the inner loop of every cone),
+//    from a one-voxel neighbourhood (cache-resident), scattered over the finest level,
+//    or scattered over every level; with or without the clip plane.
+// Args name the structure (0 cascaded, 1 dense) and, where given, the worker threads
+// (0: all cores). Set-up (loading, voxelizing, the first injection) happens once per
+// process, outside the timed loops. Sponza comes from GILAB_ASSETS or ../shared/scenes.
+#include <benchmark/benchmark.h>
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include "core/io/asset_paths.hpp"
+#include "core/render/interaction.hpp"
+#include "core/render/traced_scene.hpp"
+#include "core/util/parallel.hpp"
+#include "core/util/rng.hpp"
+#include "core/util/settings.hpp"
+#include "core/util/stats.hpp"
+#include "scenes/scene_library.hpp"
+#include "techniques/vct/cone_tracer.hpp"
+#include "techniques/vct/vct_technique.hpp"
+
+using namespace gilab;
+
+namespace {
+
+constexpr int kGbufferSide = 96;   // G-buffer points per image side
+constexpr int kDiffuseCones = 16;  // per point, as the technique's default
+const char* const kStructureNames[] = {"cascaded", "dense"};
+
+// A visible surface point: where the final gather starts its cones.
+struct GbufferPoint {
+    Vec3 position, normal;
+};
+
+struct SponzaScene {
+    Scene scene;
+    TracedScene traced;
+    Bounds3 bounds;
+    Vec3 viewer{0};
+    std::vector<GbufferPoint> points;
+};
+
+const SponzaScene* sponza() {
+    static std::optional<SponzaScene> cached;
+    static std::once_flag once;
+    std::call_once(once, [] {
+        const AssetPaths assets = AssetPaths::from_environment();
+        if (!assets.find("sponza/sponza.obj")) return;
+        SponzaScene& s = cached.emplace();
+        s.scene = open_scene("sponza", assets).scene;
+        s.traced.load(s.scene);
+        s.bounds = s.traced.frame().bounds;
+        const SceneCamera& c = *s.scene.camera;
+        s.viewer = c.position;
+        const EyeCamera cam =
+            EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, kGbufferSide, kGbufferSide);
+        for (int y = 0; y < kGbufferSide; ++y)
+            for (int x = 0; x < kGbufferSide; ++x) {
+                const Ray ray = cam.generate_ray(float(x) + 0.5f, float(y) + 0.5f);
+                const Hit hit = s.traced.tracer().intersect(ray);
+                if (!hit.valid()) continue;
+                const SurfaceInteraction si = make_interaction(s.traced.frame(), ray, hit);
+                s.points.push_back({si.position, si.shading_normal});
+            }
+    });
+    return cached ? &*cached : nullptr;
+}
+
+bool need_sponza(benchmark::State& state) {
+    if (sponza()) return true;
+    state.SkipWithError("sponza/sponza.obj not found (set GILAB_ASSETS)");
+    return false;
+}
+
+// The technique prepared on Sponza with one structure: voxelized and lit once. Its
+// schedule updates every level every frame, so update_voxels at the prepare viewer is
+// one full injection with nothing to re-voxelize.
+VctTechnique& technique(int structure) {
+    static std::unique_ptr<VctTechnique> cache[2];
+    auto& slot = cache[structure];
+    if (!slot) {
+        nlohmann::json settings = {{"structure", kStructureNames[structure]},
+                                   {"update", "strategy"},
+                                   {"update_schedule", "every"},
+                                   {"seed", 1}};
+        slot = std::make_unique<VctTechnique>();
+        slot->prepare(sponza()->scene, Settings(settings, "vct bench"));
+    }
+    return *slot;
+}
+
+// The cone options of the technique's final gather at one point (cones_at in
+// vct_technique.cpp): apex lifted a voxel off the surface, first sample a voxel out,
+// clipped to the surface's front half-space.
+struct PointCones {
+    Vec3 apex;
+    ConeOptions options;
+};
+PointCones cones_at(const VoxelConeView& view, const VctSettings& s, const Bounds3& bounds, const GbufferPoint& p) {
+    const int k = view.finest_level_containing(p.position, 1.0f);
+    const float w = k < 0 ? view.base_voxel_size() : view.level(k).voxel_size;
+    PointCones pc;
+    pc.options.step = s.cone_step;
+    pc.options.ao_lambda = s.ao_lambda;
+    pc.options.correct_opacity = s.opacity_correction;
+    pc.options.lod_bias = s.lod_bias;
+    pc.options.blend_levels = s.blend_levels;
+    pc.options.bounds = bounds;
+    if (s.max_distance > 0) pc.options.max_distance = s.max_distance;
+    pc.options.start = s.cone_start * w;
+    pc.options.clip = s.clip_plane;
+    pc.options.clip_plane = Vec4(p.normal, glm::dot(p.normal, p.position));
+    pc.apex = p.position + s.cone_offset * w * p.normal;
+    return pc;
+}
+
+void set_structure_label(benchmark::State& state, int structure, int threads) {
+    state.SetLabel(std::string(kStructureNames[structure]) + ", " +
+                   (threads > 0 ? std::to_string(threads) + " thread(s)" : std::string("all cores")));
+}
+
+void BM_ConeMarch(benchmark::State& state) {
+    if (!need_sponza(state)) return;
+    const int structure = int(state.range(0)), threads = int(state.range(1));
+    VctTechnique& t = technique(structure);
+    const SponzaScene& s = *sponza();
+    const VoxelConeView view = t.radiance_view();
+    const ConeSet set = hemisphere_cones(kDiffuseCones);
+    std::vector<PointCones> setup;
+    for (const GbufferPoint& p : s.points) setup.push_back(cones_at(view, t.settings(), s.bounds, p));
+    ThreadLimit limit(threads);
+    // One pass over every point's cones; returns the samples taken.
+    auto march = [&] {
+        std::atomic<uint64_t> samples{0};
+        parallel_for(s.points.size(), 64, [&](size_t b, size_t e) {
+            uint64_t local = 0;
+            Vec3 sum(0);
+            for (size_t i = b; i < e; ++i) {
+                const Frame frame(s.points[i].normal);
+                for (size_t c = 0; c < set.directions.size(); ++c) {
+                    const Cone cone{setup[i].apex, frame.to_world(set.directions[c]), set.tan_half_angle};
+                    const ConeResult r = trace_cone(view, cone, setup[i].options);
+                    sum += r.radiance;
+                    local += uint64_t(r.samples);
+                }
+            }
+            benchmark::DoNotOptimize(sum);
+            samples += local;
+        });
+        return samples.load();
+    };
+    const uint64_t per_pass = march();  // warm-up, outside the timed loop
+    uint64_t total = 0;
+    for (auto _ : state) total += march();
+    const double cones = double(s.points.size()) * double(set.directions.size());
+    state.counters["points"] = double(s.points.size());
+    state.counters["samples_per_cone"] = double(per_pass) / cones;
+    state.counters["cones_per_s"] = benchmark::Counter(cones * double(state.iterations()), benchmark::Counter::kIsRate);
+    state.counters["samples_per_s"] = benchmark::Counter(double(total), benchmark::Counter::kIsRate);
+    state.counters["s_per_sample"] =
+        benchmark::Counter(double(total), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+    set_structure_label(state, structure, threads);
+}
+BENCHMARK(BM_ConeMarch)
+    ->ArgsProduct({{0, 1}, {1, 0}})
+    ->ArgNames({"structure", "threads"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+void BM_Injection(benchmark::State& state) {
+    if (!need_sponza(state)) return;
+    const int structure = int(state.range(0)), threads = int(state.range(1));
+    VctTechnique& t = technique(structure);
+    const Vec3 viewer = sponza()->viewer;
+    ThreadLimit limit(threads);
+    double update = 0, direct = 0, bounce = 0, filter = 0, samples = 0;
+    Stats stats;
+    for (auto _ : state) {
+        t.update_voxels(viewer);
+        stats = t.stats();
+        update += stats.get("update_ms");
+        direct += stats.get("injection_direct_ms");
+        bounce += stats.get("injection_bounce_ms");
+        filter += stats.get("filter_ms");
+        samples += stats.get("injection_cone_samples");
+    }
+    const double n = double(state.iterations());
+    state.counters["voxels_lit"] = stats.get("voxels_lit");
+    state.counters["faces_lit"] = stats.get("injection_faces_lit");
+    state.counters["bounce_cones"] = stats.get("injection_cones_traced");
+    state.counters["bounce_samples"] = stats.get("injection_cone_samples");
+    state.counters["update_ms"] = update / n;
+    state.counters["direct_ms"] = direct / n;
+    state.counters["bounce_ms"] = bounce / n;
+    state.counters["filter_ms"] = filter / n;
+    state.counters["bounce_samples_per_s"] = bounce > 0 ? samples / (bounce * 1e-3) : 0.0;
+    state.counters["samples_per_s"] = benchmark::Counter(samples, benchmark::Counter::kIsRate);
+    set_structure_label(state, structure, threads);
+}
+BENCHMARK(BM_Injection)
+    ->ArgsProduct({{0, 1}, {1, 0}})
+    ->ArgNames({"structure", "threads"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+void BM_AnisotropicFilter(benchmark::State& state) {
+    if (!need_sponza(state)) return;
+    const int structure = int(state.range(0)), threads = int(state.range(1));
+    VctTechnique& t = technique(structure);
+    ThreadLimit limit(threads);
+    double cells = 0;  // coarse cells written per pass, each from 8 finer ones
+    if (const CascadedVoxelTexture* c = t.cascade()) {
+        std::vector<Vec4> buffer = c->radiance;  // each pass rewrites the same values
+        for (int k = 1; k < c->levels(); ++k) cells += double(c->inner_box(k).volume()) * kFaceCount;
+        for (auto _ : state) {
+            for (int k = 1; k < c->levels(); ++k) c->downsample(k, buffer);
+            benchmark::DoNotOptimize(buffer.data());
+        }
+    } else {
+        const DenseMipTexture& d = *t.dense();
+        std::vector<std::vector<Vec4>> buffer = d.radiance;
+        for (int k = 1; k < d.level_count(); ++k) cells += double(d.cells(k));
+        for (auto _ : state) {
+            d.build_mips(buffer);
+            benchmark::DoNotOptimize(buffer.back().data());
+        }
+    }
+    const double n = double(state.iterations());
+    state.counters["cells"] = cells;
+    state.counters["cells_per_s"] = benchmark::Counter(cells * n, benchmark::Counter::kIsRate);
+    // Eight finer cells read and one written per coarse cell, 16 bytes each.
+    state.counters["bytes_per_s"] = benchmark::Counter(cells * n * 9.0 * sizeof(Vec4), benchmark::Counter::kIsRate);
+    set_structure_label(state, structure, threads);
+}
+BENCHMARK(BM_AnisotropicFilter)
+    ->ArgsProduct({{0, 1}, {1, 0}})
+    ->ArgNames({"structure", "threads"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// One thread. Pattern 0: positions within one finest voxel's neighbourhood (every
+// texel in L1); 1: scattered over the finest level's region; 2: scattered over every
+// level's region (cascades: a random level, dense: a random mip level).
+void BM_SampleLevel(benchmark::State& state) {
+    if (!need_sponza(state)) return;
+    const int structure = int(state.range(0)), pattern = int(state.range(1));
+    const bool with_plane = state.range(2) != 0;
+    VctTechnique& t = technique(structure);
+    const VoxelConeView view = t.radiance_view();
+    const Vec3 centre = sponza()->points[sponza()->points.size() / 2].position;
+    constexpr size_t kCount = size_t(1) << 16;
+    std::vector<int> level(kCount);
+    std::vector<Vec3> position(kCount);
+    std::vector<FaceWeights> faces(kCount);
+    std::vector<Vec4> plane(kCount);
+    Rng rng(7, 1);
+    const Vec3 anchor = structure == 0 ? Vec3(t.cascade()->config().anchor) : Vec3(t.dense()->config().anchor);
+    for (size_t i = 0; i < kCount; ++i) {
+        int k = 0;
+        if (pattern == 2) k = std::min(int(rng.uniform() * float(view.level_count())), view.level_count() - 1);
+        const ConeLevel& l = view.level(k);
+        Vec3 p;
+        if (pattern == 0) {
+            p = centre + (Vec3(rng.uniform(), rng.uniform(), rng.uniform()) - Vec3(0.5f)) * (2.0f * l.voxel_size);
+        } else {
+            const Vec3 u(rng.uniform(), rng.uniform(), rng.uniform());
+            p = anchor + (Vec3(l.origin) + u * float(l.size)) * l.voxel_size;
+        }
+        level[i] = k;
+        position[i] = p;
+        const Vec3 d = glm::normalize(Vec3(rng.uniform(), rng.uniform(), rng.uniform()) - Vec3(0.5f) + Vec3(1e-3f));
+        faces[i] = faces_seen_along(d);
+        // A surface half a voxel behind the sample, facing along the cone: the plane cuts
+        // some of the eight voxels, as it does for the first samples of a cone.
+        plane[i] = Vec4(d, glm::dot(d, p) - 0.5f * l.voxel_size);
+    }
+    Vec4 sum(0);
+    for (auto _ : state) {
+        for (size_t i = 0; i < kCount; ++i)
+            sum += view.sample_level(level[i], position[i], faces[i], with_plane ? &plane[i] : nullptr);
+        benchmark::DoNotOptimize(sum);
+    }
+    const double n = double(state.iterations()) * double(kCount);
+    state.counters["samples_per_s"] = benchmark::Counter(n, benchmark::Counter::kIsRate);
+    state.counters["s_per_sample"] = benchmark::Counter(n, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+    static const char* const kPatterns[] = {"one voxel", "finest level", "every level"};
+    state.SetLabel(std::string(kStructureNames[structure]) + ", " + kPatterns[pattern] +
+                   (with_plane ? ", clip plane" : ""));
+}
+BENCHMARK(BM_SampleLevel)
+    ->ArgsProduct({{0, 1}, {0, 1, 2}, {0, 1}})
+    ->ArgNames({"structure", "pattern", "plane"})
+    ->Unit(benchmark::kMicrosecond);
+
+}  // namespace
