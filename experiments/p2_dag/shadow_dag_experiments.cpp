@@ -344,10 +344,18 @@ ExperimentOutput reduce_fig15(const SpecReduction& r) {
         plot_s3.series.push_back(g3);
     }
     add_paper_growth(plot_s2, plot_s3);
-    for (Plot* p : {&plot_s2, &plot_s3})
-        p->series.push_back(PlotSeries{"S1 (4, by construction)", {double(sizes.front()), double(sizes[sizes.size() - 2])},
-                                       {4.0, 4.0}, false, false, 6});
+    if (sizes.size() >= 2)
+        for (Plot* p : {&plot_s2, &plot_s3})
+            p->series.push_back(PlotSeries{"S1 (4, by construction)",
+                                           {double(sizes.front()), double(sizes[sizes.size() - 2])}, {4.0, 4.0}, false,
+                                           false, 6});
     ExperimentOutput out;
+    if (t.rows.empty()) {
+        std::string swept;
+        for (uint32_t n : sizes) swept += (swept.empty() ? "" : ", ") + std::to_string(n);
+        out.notes.push_back("No growth factor: Fig. 15 divides the storage at 2N by that at N, and the resolutions run "
+                            "here (" + swept + ") hold no such pair with results.");
+    }
     out.tables.push_back(t);
     out.plots.push_back({"fig15_growth_s2", plot_s2});
     out.plots.push_back({"fig15_growth_s3", plot_s3});
