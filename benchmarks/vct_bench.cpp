@@ -3,6 +3,9 @@
 // finest voxel, so each phase compares like for like:
 //  - BM_ConeMarch: 16 diffuse cones from each of 96×96 G-buffer points (primary hits of
 //    the scene camera), traced as the technique's final gather traces them;
+//  - BM_ConeMarchLayout: the same on one thread with the radiance laid out as the
+//    technique stores it (a voxel's six faces together) or as P3's Fig. 2 (one block
+//    per face), with and without skipping samples the occupancy map marks empty;
 //  - BM_Injection: one full light injection over the occupied voxels (direct light by
 //    shadow rays, anisotropic filtering, the voxel bounce, filtering again), with its
 //    phases as counters from the technique's stats;
@@ -132,39 +135,36 @@ void set_structure_label(benchmark::State& state, int structure, int threads) {
                    (threads > 0 ? std::to_string(threads) + " thread(s)" : std::string("all cores")));
 }
 
-void BM_ConeMarch(benchmark::State& state) {
-    if (!need_sponza(state)) return;
-    const int structure = int(state.range(0)), threads = int(state.range(1));
-    VctTechnique& t = technique(structure);
+// One pass over every G-buffer point's diffuse cones; returns the samples taken.
+uint64_t march_all(const VoxelConeView& view, const SponzaScene& s, const ConeSet& set,
+                   const std::vector<PointCones>& setup) {
+    std::atomic<uint64_t> samples{0};
+    parallel_for(s.points.size(), 64, [&](size_t b, size_t e) {
+        uint64_t local = 0;
+        Vec3 sum(0);
+        for (size_t i = b; i < e; ++i) {
+            const Frame frame(s.points[i].normal);
+            for (size_t c = 0; c < set.directions.size(); ++c) {
+                const Cone cone{setup[i].apex, frame.to_world(set.directions[c]), set.tan_half_angle};
+                const ConeResult r = trace_cone(view, cone, setup[i].options);
+                sum += r.radiance;
+                local += uint64_t(r.samples);
+            }
+        }
+        benchmark::DoNotOptimize(sum);
+        samples += local;
+    });
+    return samples.load();
+}
+
+void time_march(benchmark::State& state, const VoxelConeView& view, const VctTechnique& t) {
     const SponzaScene& s = *sponza();
-    const VoxelConeView view = t.radiance_view();
     const ConeSet set = hemisphere_cones(kDiffuseCones);
     std::vector<PointCones> setup;
     for (const GbufferPoint& p : s.points) setup.push_back(cones_at(view, t.settings(), s.bounds, p));
-    ThreadLimit limit(threads);
-    // One pass over every point's cones; returns the samples taken.
-    auto march = [&] {
-        std::atomic<uint64_t> samples{0};
-        parallel_for(s.points.size(), 64, [&](size_t b, size_t e) {
-            uint64_t local = 0;
-            Vec3 sum(0);
-            for (size_t i = b; i < e; ++i) {
-                const Frame frame(s.points[i].normal);
-                for (size_t c = 0; c < set.directions.size(); ++c) {
-                    const Cone cone{setup[i].apex, frame.to_world(set.directions[c]), set.tan_half_angle};
-                    const ConeResult r = trace_cone(view, cone, setup[i].options);
-                    sum += r.radiance;
-                    local += uint64_t(r.samples);
-                }
-            }
-            benchmark::DoNotOptimize(sum);
-            samples += local;
-        });
-        return samples.load();
-    };
-    const uint64_t per_pass = march();  // warm-up, outside the timed loop
+    const uint64_t per_pass = march_all(view, s, set, setup);  // warm-up, outside the timed loop
     uint64_t total = 0;
-    for (auto _ : state) total += march();
+    for (auto _ : state) total += march_all(view, s, set, setup);
     const double cones = double(s.points.size()) * double(set.directions.size());
     state.counters["points"] = double(s.points.size());
     state.counters["samples_per_cone"] = double(per_pass) / cones;
@@ -172,11 +172,82 @@ void BM_ConeMarch(benchmark::State& state) {
     state.counters["samples_per_s"] = benchmark::Counter(double(total), benchmark::Counter::kIsRate);
     state.counters["s_per_sample"] =
         benchmark::Counter(double(total), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+void BM_ConeMarch(benchmark::State& state) {
+    if (!need_sponza(state)) return;
+    const int structure = int(state.range(0)), threads = int(state.range(1));
+    VctTechnique& t = technique(structure);
+    ThreadLimit limit(threads);
+    time_march(state, t.radiance_view(), t);
     set_structure_label(state, structure, threads);
 }
 BENCHMARK(BM_ConeMarch)
     ->ArgsProduct({{0, 1}, {1, 0}})
     ->ArgNames({"structure", "threads"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// A copy of a view's radiance with each level stored face block by face block
+// ([face][z][y][x], P3's Fig. 2 order within a level), and its levels pointing there.
+struct FaceBlockCopy {
+    std::vector<std::vector<HalfRGBA>> levels;
+    VoxelConeView view;
+};
+FaceBlockCopy face_blocks(const VoxelConeView& view, const Vec3& anchor, bool nested) {
+    FaceBlockCopy copy;
+    std::vector<ConeLevel> levels;
+    for (int k = 0; k < view.level_count(); ++k) {
+        const ConeLevel& from = view.level(k);
+        const size_t r = size_t(from.size);
+        std::vector<HalfRGBA>& cells = copy.levels.emplace_back(r * r * r * kFaceCount);
+        for (size_t z = 0; z < r; ++z)
+            for (size_t y = 0; y < r; ++y)
+                for (size_t x = 0; x < r; ++x)
+                    for (int f = 0; f < kFaceCount; ++f)
+                        cells[size_t(f) * r * r * r + (z * r + y) * r + x] =
+                            from.data[z * from.slice_stride + y * from.row_stride + x * from.x_stride +
+                                      size_t(f) * from.face_stride];
+        ConeLevel to = from;
+        to.data = cells.data();
+        to.face_stride = r * r * r;
+        to.x_stride = 1;
+        to.row_stride = r;
+        to.slice_stride = r * r;
+        levels.push_back(to);
+    }
+    copy.view = VoxelConeView::of_levels(anchor, nested, std::move(levels));
+    return copy;
+}
+
+void BM_ConeMarchLayout(benchmark::State& state) {
+    if (!need_sponza(state)) return;
+    const int structure = int(state.range(0)), layout = int(state.range(1));
+    const bool skip = state.range(2) != 0;
+    VctTechnique& t = technique(structure);
+    ThreadLimit limit(1);
+    const Vec3 anchor = structure == 0 ? Vec3(t.cascade()->config().anchor) : Vec3(t.dense()->config().anchor);
+    FaceBlockCopy copy;
+    VoxelConeView view = t.radiance_view();
+    if (layout == 1) {
+        copy = face_blocks(view, anchor, structure == 0);
+        view = copy.view;
+    }
+    if (!skip) {
+        std::vector<ConeLevel> levels;
+        for (int k = 0; k < view.level_count(); ++k) {
+            levels.push_back(view.level(k));
+            levels.back().occupancy = nullptr;
+        }
+        view = VoxelConeView::of_levels(anchor, structure == 0, std::move(levels));
+    }
+    time_march(state, view, t);
+    state.SetLabel(std::string(kStructureNames[structure]) + (layout == 0 ? ", faces together" : ", face blocks") +
+                   (skip ? ", occupancy skip" : ", no skip"));
+}
+BENCHMARK(BM_ConeMarchLayout)
+    ->ArgsProduct({{0, 1}, {0, 1}, {1, 0}})
+    ->ArgNames({"structure", "layout", "skip"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
@@ -223,7 +294,7 @@ void BM_AnisotropicFilter(benchmark::State& state) {
     ThreadLimit limit(threads);
     double cells = 0;  // coarse cells written per pass, each from 8 finer ones
     if (const CascadedVoxelTexture* c = t.cascade()) {
-        std::vector<Vec4> buffer = c->radiance;  // each pass rewrites the same values
+        std::vector<HalfRGBA> buffer = c->radiance;  // each pass rewrites the same values
         for (int k = 1; k < c->levels(); ++k) cells += double(c->inner_box(k).volume()) * kFaceCount;
         for (auto _ : state) {
             for (int k = 1; k < c->levels(); ++k) c->downsample(k, buffer);
@@ -231,7 +302,7 @@ void BM_AnisotropicFilter(benchmark::State& state) {
         }
     } else {
         const DenseMipTexture& d = *t.dense();
-        std::vector<std::vector<Vec4>> buffer = d.radiance;
+        std::vector<std::vector<HalfRGBA>> buffer = d.radiance;
         for (int k = 1; k < d.level_count(); ++k) cells += double(d.cells(k));
         for (auto _ : state) {
             d.build_mips(buffer);
@@ -241,8 +312,8 @@ void BM_AnisotropicFilter(benchmark::State& state) {
     const double n = double(state.iterations());
     state.counters["cells"] = cells;
     state.counters["cells_per_s"] = benchmark::Counter(cells * n, benchmark::Counter::kIsRate);
-    // Eight finer cells read and one written per coarse cell, 16 bytes each.
-    state.counters["bytes_per_s"] = benchmark::Counter(cells * n * 9.0 * sizeof(Vec4), benchmark::Counter::kIsRate);
+    // Eight finer cells read and one written per coarse cell.
+    state.counters["bytes_per_s"] = benchmark::Counter(cells * n * 9.0 * sizeof(HalfRGBA), benchmark::Counter::kIsRate);
     set_structure_label(state, structure, threads);
 }
 BENCHMARK(BM_AnisotropicFilter)

@@ -18,8 +18,9 @@ void CascadeConfig::validate() const {
         throw Error(where, "voxel size must be positive and finite, got " + std::to_string(voxel_size));
     if (!std::isfinite(anchor.x) || !std::isfinite(anchor.y) || !std::isfinite(anchor.z))
         throw Error(where, "anchor must be finite");
+    // Per cell: the G-buffer (52 bytes) and two RGBA16F radiance values.
     double cells = double(levels) * double(resolution) * double(resolution) * double(resolution) * kFaceCount;
-    if (cells * 80.0 > double(size_t(8) << 30))
+    if (cells * 68.0 > double(size_t(8) << 30))
         throw Error(where, std::to_string(levels) + " levels of " + std::to_string(resolution) +
                                "³ would need more than 8 GiB");
 }
@@ -35,8 +36,9 @@ CascadedVoxelTexture::CascadedVoxelTexture(const CascadeConfig& config) : config
     normal.assign(n, Vec3(0));
     emission.assign(n, Vec3(0));
     position.assign(n, Vec3(0));
-    direct.assign(n, Vec4(0));
-    radiance.assign(n, Vec4(0));
+    direct.assign(n, HalfRGBA{});
+    radiance.assign(n, HalfRGBA{});
+    occupancy_.assign(size_t(config_.levels) * texels_per_level(), 1);
 }
 
 VoxelBox CascadedVoxelTexture::region(int level) const {
@@ -93,12 +95,13 @@ void CascadedVoxelTexture::place(int level, const IVec3& origin) {
     const int R = config_.resolution;
     gilab::parallel_for(size_t(R), 1, [&](size_t z0, size_t z1) {
         for (size_t z = z0; z < z1; ++z) {
-            const size_t first = index(0, level, UVec3(0, 0, uint32_t(z))), n = size_t(R) * width();
+            const size_t first = index(0, level, UVec3(0, 0, uint32_t(z))), n = size_t(R) * size_t(R) * kFaceCount;
             std::fill_n(opacity.begin() + ptrdiff_t(first), n, 0.0f);
             for (auto* a : {&albedo, &normal, &emission, &position}) std::fill_n(a->begin() + ptrdiff_t(first), n, Vec3(0));
-            for (auto* a : {&direct, &radiance}) std::fill_n(a->begin() + ptrdiff_t(first), n, Vec4(0));
+            for (auto* a : {&direct, &radiance}) std::fill_n(a->begin() + ptrdiff_t(first), n, HalfRGBA{});
         }
     });
+    std::fill_n(occupancy_.begin() + ptrdiff_t(size_t(level) * texels_per_level()), texels_per_level(), uint8_t(1));
     gbuffer_clear_[size_t(level)] = true;
 }
 
@@ -114,8 +117,8 @@ void for_each_voxel(const VoxelBox& box, Fn&& fn) {
 
 }  // namespace
 
-// Calls fn(first_cell, count) for every contiguous run of cells (one face, one texel
-// row) that the box's voxels occupy; a row wraps around the toroidal storage at most once.
+// Calls fn(first_cell, count) for every contiguous run of cells (one texel row, all six
+// faces) that the box's voxels occupy; a row wraps around the toroidal storage at most once.
 template <class Fn>
 void CascadedVoxelTexture::for_each_run(int level, const VoxelBox& box, Fn&& fn) const {
     const VoxelBox b = box.intersect(region(level));
@@ -124,12 +127,11 @@ void CascadedVoxelTexture::for_each_run(int level, const VoxelBox& box, Fn&& fn)
     const int x0 = b.begin.x & mask, nx = b.end.x - b.begin.x;
     const int first = std::min(nx, R - x0), second = nx - first;
     for (int z = b.begin.z; z < b.end.z; ++z)
-        for (int y = b.begin.y; y < b.end.y; ++y)
-            for (int f = 0; f < kFaceCount; ++f) {
-                const UVec3 t(uint32_t(x0), uint32_t(y & mask), uint32_t(z & mask));
-                fn(index(f, level, t), size_t(first));
-                if (second > 0) fn(index(f, level, UVec3(0, t.y, t.z)), size_t(second));
-            }
+        for (int y = b.begin.y; y < b.end.y; ++y) {
+            const UVec3 t(uint32_t(x0), uint32_t(y & mask), uint32_t(z & mask));
+            fn(index(0, level, t), size_t(first) * kFaceCount);
+            if (second > 0) fn(index(0, level, UVec3(0, t.y, t.z)), size_t(second) * kFaceCount);
+        }
 }
 
 void CascadedVoxelTexture::clear_gbuffer(int level, const VoxelBox& box) {
@@ -145,8 +147,8 @@ void CascadedVoxelTexture::clear_gbuffer(int level, const VoxelBox& box) {
 
 void CascadedVoxelTexture::clear_radiance(int level, const VoxelBox& box) {
     for_each_run(level, box, [&](size_t i, size_t n) {
-        std::fill_n(direct.begin() + ptrdiff_t(i), n, Vec4(0));
-        std::fill_n(radiance.begin() + ptrdiff_t(i), n, Vec4(0));
+        std::fill_n(direct.begin() + ptrdiff_t(i), n, HalfRGBA{});
+        std::fill_n(radiance.begin() + ptrdiff_t(i), n, HalfRGBA{});
     });
 }
 
@@ -178,6 +180,8 @@ std::vector<VoxelBox> CascadedVoxelTexture::scroll(int level, const IVec3& new_o
         }
     }
     const bool has_coarser = level + 1 < config_.levels;
+    // The exposed texels take new opacity: nothing is skipped until the next refresh.
+    std::fill_n(occupancy_.begin() + ptrdiff_t(size_t(level) * texels_per_level()), texels_per_level(), uint8_t(1));
     for (const VoxelBox& box : exposed) {
         clear_gbuffer(level, box);
         for_each_voxel(box, [&](const IVec3& v) {
@@ -190,7 +194,7 @@ std::vector<VoxelBox> CascadedVoxelTexture::scroll(int level, const IVec3& new_o
                     direct[i] = direct[j];
                     radiance[i] = radiance[j];
                 } else {
-                    direct[i] = radiance[i] = Vec4(0);
+                    direct[i] = radiance[i] = HalfRGBA{};
                 }
             }
         });
@@ -314,7 +318,7 @@ std::vector<IVec3> CascadedVoxelTexture::occupied_in(int level, const VoxelBox& 
     return out;
 }
 
-void CascadedVoxelTexture::downsample(int level, std::vector<Vec4>& buffer) const {
+void CascadedVoxelTexture::downsample(int level, std::vector<HalfRGBA>& buffer) const {
     const VoxelBox box = inner_box(level);
     if (box.empty()) return;
     const int zs = box.end.z - box.begin.z;
@@ -324,18 +328,45 @@ void CascadedVoxelTexture::downsample(int level, std::vector<Vec4>& buffer) cons
             for (int y = box.begin.y; y < box.end.y; ++y)
                 for (int x = box.begin.x; x < box.end.x; ++x) {
                     const IVec3 v(x, y, z);
-                    for (int f = 0; f < kFaceCount; ++f) {
-                        std::array<Vec4, 8> children;
-                        for (int c = 0; c < 8; ++c) {
-                            const IVec3 child = 2 * v + IVec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
-                            children[size_t(c)] =
-                                contains(level - 1, child) ? buffer[index_of_voxel(f, level - 1, child)] : Vec4(0);
-                        }
-                        buffer[index_of_voxel(f, level, v)] = downsample_face(f, children);
+                    // The eight children with all six faces, decoded once.
+                    std::array<std::array<Vec4, 8>, kFaceCount> children{};
+                    for (int c = 0; c < 8; ++c) {
+                        const IVec3 child = 2 * v + IVec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+                        if (!contains(level - 1, child)) continue;
+                        const size_t first = index_of_voxel(0, level - 1, child);
+                        for (int f = 0; f < kFaceCount; ++f)
+                            children[size_t(f)][size_t(c)] = from_half_rgba(buffer[first + size_t(f)]);
                     }
+                    const size_t out = index_of_voxel(0, level, v);
+                    for (int f = 0; f < kFaceCount; ++f)
+                        buffer[out + size_t(f)] = to_half_rgba(downsample_face(f, children[size_t(f)]));
                 }
         }
     });
+}
+
+void CascadedVoxelTexture::refresh_occupancy(int level, const std::vector<HalfRGBA>& buffer) {
+    const int R = config_.resolution, mask = R - 1;
+    const size_t texels = texels_per_level();
+    std::vector<uint8_t> any(texels, 0);
+    const HalfRGBA* cells = buffer.data() + size_t(level) * level_cells();
+    for (size_t t = 0; t < texels; ++t)
+        for (int f = 0; f < kFaceCount; ++f)
+            if (has_opacity(cells[t * kFaceCount + size_t(f)])) {
+                any[t] = 1;
+                break;
+            }
+    uint8_t* out = occupancy_.data() + size_t(level) * texels;
+    for (int z = 0; z < R; ++z)
+        for (int y = 0; y < R; ++y)
+            for (int x = 0; x < R; ++x) {
+                uint8_t o = 0;
+                for (int c = 0; c < 8; ++c) {
+                    const int tx = (x + (c & 1)) & mask, ty = (y + ((c >> 1) & 1)) & mask, tz = (z + (c >> 2)) & mask;
+                    o |= any[(size_t(tz) * size_t(R) + size_t(ty)) * size_t(R) + size_t(tx)];
+                }
+                out[(size_t(z) * size_t(R) + size_t(y)) * size_t(R) + size_t(x)] = o;
+            }
 }
 
 size_t CascadedVoxelTexture::gbuffer_bytes() const {
@@ -343,6 +374,8 @@ size_t CascadedVoxelTexture::gbuffer_bytes() const {
            (albedo.size() + normal.size() + emission.size() + position.size()) * sizeof(Vec3);
 }
 
-size_t CascadedVoxelTexture::radiance_bytes() const { return (direct.size() + radiance.size()) * sizeof(Vec4); }
+size_t CascadedVoxelTexture::radiance_bytes() const {
+    return (direct.size() + radiance.size()) * sizeof(HalfRGBA) + occupancy_.size();
+}
 
 }  // namespace gilab

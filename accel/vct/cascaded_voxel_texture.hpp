@@ -1,10 +1,13 @@
 #pragma once
 // Cascaded voxel texture (P3 §1.1): n nested, viewer-centred cascades of R³ voxels,
 // level k having voxels of size voxel_size·2^k. Every voxel keeps six faces (see
-// accel/vct/anisotropic_voxel.hpp). Each attribute is one allocation laid out as the paper's
-// Fig. 2: a 3D array of 6R × nR × R cells whose x axis is the six faces side by side,
-// y axis the n levels stacked, z the third voxel axis — so cell
-// (face·R + tx, level·R + ty, tz) holds texel (tx, ty, tz) of that face and level.
+// accel/vct/anisotropic_voxel.hpp). Each attribute is one allocation: level after level,
+// a level an R³ block in (z, y, x) order, and a voxel's six faces side by side, so the
+// cell of (face, level, texel) is ((level·R + z)·R + y)·R + x)·6 + face. P3's Fig. 2
+// puts the six faces and the levels side by side in one GPU texture (x = faces, y =
+// levels) so the texture unit can filter them; a CPU sampler addresses each level
+// directly and reads the three faces a cone sees from one place (one cache line per
+// texel at RGBA16F), which `vct_bench` measured faster than face blocks.
 //
 // Voxels are addressed by world voxel coordinates on the level's lattice (voxel v of
 // level k spans anchor + [v, v+1)·voxel_size·2^k). A level covers the box
@@ -17,6 +20,7 @@
 #include <vector>
 #include "accel/vct/anisotropic_voxel.hpp"
 #include "accel/vct/fragment_voxelizer.hpp"
+#include "accel/vct/half_rgba.hpp"
 #include "core/util/math.hpp"
 
 namespace gilab {
@@ -72,16 +76,18 @@ public:
     }
     // The voxel of the current region stored at a texel (inverse of texel_of).
     IVec3 voxel_at_texel(int level, const UVec3& texel) const;
-    // Cell index of (face, level, texel) in every attribute array (Fig. 2 layout).
+    // Cell index of (face, level, texel) in every attribute array.
     size_t index(int face, int level, const UVec3& texel) const {
         const size_t R = size_t(config_.resolution);
-        return (size_t(texel.z) * height() + size_t(level) * R + texel.y) * width() + size_t(face) * R + texel.x;
+        return (((size_t(level) * R + texel.z) * R + texel.y) * R + texel.x) * size_t(kFaceCount) + size_t(face);
     }
     size_t index_of_voxel(int face, int level, const IVec3& v) const { return index(face, level, texel_of(v)); }
-    size_t width() const { return size_t(kFaceCount) * size_t(config_.resolution); }   // x: 6 faces
-    size_t height() const { return size_t(config_.levels) * size_t(config_.resolution); }  // y: n levels
-    size_t depth() const { return size_t(config_.resolution); }
-    size_t cell_count() const { return width() * height() * depth(); }
+    size_t level_cells() const { return texels_per_level() * size_t(kFaceCount); }
+    size_t texels_per_level() const {
+        const size_t R = size_t(config_.resolution);
+        return R * R * R;
+    }
+    size_t cell_count() const { return size_t(config_.levels) * level_cells(); }
 
     // ---- G-buffer
     void clear_gbuffer(int level, const VoxelBox& box);         // box ∩ region
@@ -112,23 +118,31 @@ public:
 
     // ---- anisotropic filtering: the inner box of `level` from level − 1 (2×2×2 → 1 per
     // face, front-to-back along the face's axis) in one of the radiance buffers.
-    void downsample(int level, std::vector<Vec4>& buffer) const;
+    void downsample(int level, std::vector<HalfRGBA>& buffer) const;
+
+    // ---- occupancy for cone marching: per level and texel t, whether any face of the
+    // 2×2×2 texels from t up (toroidally) has opacity in `buffer` — the texels one
+    // trilinear sample reads. A sample whose byte is 0 reads nothing and is skipped.
+    // Starts all 1 (nothing skipped) and is exact after a refresh. Both radiance buffers
+    // carry the same opacity, so one map serves both.
+    void refresh_occupancy(int level, const std::vector<HalfRGBA>& buffer);
+    const uint8_t* occupancy(int level) const { return occupancy_.data() + size_t(level) * texels_per_level(); }
 
     // ---- memory
-    size_t voxel_count() const { return size_t(config_.levels) * size_t(depth() * depth() * depth()); }
+    size_t voxel_count() const { return size_t(config_.levels) * texels_per_level(); }
     size_t gbuffer_bytes() const;
-    size_t radiance_bytes() const;
+    size_t radiance_bytes() const;  // both radiance buffers and the occupancy map
     size_t bytes() const { return gbuffer_bytes() + radiance_bytes(); }
     // What the paper's Tables 5/6 count: opacity only, one byte per voxel per face.
     size_t opacity_bytes_paper() const { return voxel_count() * size_t(kFaceCount); }
 
-    // Attributes, one allocation each (Fig. 2 layout). G-buffer: opacity, albedo,
-    // normal, emission, position. Radiance (V-buffer), premultiplied RGBA with alpha the
-    // opacity: `direct` (direct light only) and `radiance` (direct + voxel bounce), both
+    // Attributes, one allocation each. G-buffer: opacity, albedo, normal, emission,
+    // position. Radiance (V-buffer), premultiplied RGBA16F with alpha the opacity:
+    // `direct` (direct light only) and `radiance` (direct + voxel bounce), both
     // anisotropically filtered from finer levels.
     std::vector<float> opacity;
     std::vector<Vec3> albedo, normal, emission, position;
-    std::vector<Vec4> direct, radiance;
+    std::vector<HalfRGBA> direct, radiance;
 
 private:
     template <class Fn>
@@ -137,6 +151,7 @@ private:
     std::vector<IVec3> origins_;
     std::vector<VoxelBox> own_inner_;  // inner box excluded by the last voxelize_own / follow_inner
     std::vector<char> gbuffer_clear_;  // per level: nothing written since the last full clear
+    std::vector<uint8_t> occupancy_;   // see refresh_occupancy
 };
 
 // a − b as disjoint boxes (at most six).

@@ -1,5 +1,6 @@
 #include "accel/vct/dense_mip_texture.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -14,7 +15,7 @@ namespace {
 double buffer_bytes(int resolution) {
     double cells = 0;
     for (int r = resolution; r >= 1; r >>= 1) cells += double(kFaceCount) * double(r) * r * r;
-    return 2.0 * cells * double(sizeof(Vec4));  // direct + radiance
+    return 2.0 * cells * double(sizeof(HalfRGBA));  // direct + radiance
 }
 
 }  // namespace
@@ -39,9 +40,11 @@ DenseMipTexture::DenseMipTexture(const DenseMipConfig& config) : config_(config)
     const int levels = std::countr_zero(unsigned(config_.resolution)) + 1;
     direct.resize(size_t(levels));
     radiance.resize(size_t(levels));
+    occupancy_.resize(size_t(levels));
     for (int k = 0; k < levels; ++k) {
-        direct[size_t(k)].assign(cells(k), Vec4(0));
-        radiance[size_t(k)].assign(cells(k), Vec4(0));
+        direct[size_t(k)].assign(cells(k), HalfRGBA{});
+        radiance[size_t(k)].assign(cells(k), HalfRGBA{});
+        occupancy_[size_t(k)].assign(cells(k) / kFaceCount, 1);
     }
 }
 
@@ -51,29 +54,64 @@ FragmentVoxelizeStats DenseMipTexture::voxelize(const FragmentVoxelizer& voxeliz
     return stats;
 }
 
-void DenseMipTexture::clear_level0(std::vector<std::vector<Vec4>>& buffer) {
+void DenseMipTexture::clear_level0(std::vector<std::vector<HalfRGBA>>& buffer) {
     auto& level = buffer.at(0);
     parallel_for(level.size(), size_t(1) << 20, [&](size_t b, size_t e) {
-        std::memset(static_cast<void*>(level.data() + b), 0, (e - b) * sizeof(Vec4));
+        std::memset(static_cast<void*>(level.data() + b), 0, (e - b) * sizeof(HalfRGBA));
     });
 }
 
-void DenseMipTexture::build_mips(std::vector<std::vector<Vec4>>& buffer) const {
+void DenseMipTexture::build_mips(std::vector<std::vector<HalfRGBA>>& buffer) const {
     for (int k = 1; k < level_count(); ++k) {
         const int r = resolution(k);
-        const std::vector<Vec4>& fine = buffer[size_t(k - 1)];
-        std::vector<Vec4>& coarse = buffer[size_t(k)];
+        const std::vector<HalfRGBA>& fine = buffer[size_t(k - 1)];
+        std::vector<HalfRGBA>& coarse = buffer[size_t(k)];
         parallel_for(size_t(r), 1, [&](size_t z0, size_t z1) {
             for (size_t z = z0; z < z1; ++z)
                 for (int y = 0; y < r; ++y)
                     for (int x = 0; x < r; ++x) {
                         const IVec3 v(x, y, int(z));
-                        for (int f = 0; f < kFaceCount; ++f) {
-                            std::array<Vec4, 8> children;
-                            for (int c = 0; c < 8; ++c)
-                                children[size_t(c)] = fine[index(k - 1, f, 2 * v + IVec3(c & 1, (c >> 1) & 1, (c >> 2) & 1))];
-                            coarse[index(k, f, v)] = downsample_face(f, children);
+                        std::array<std::array<Vec4, 8>, kFaceCount> children;
+                        for (int c = 0; c < 8; ++c) {
+                            const size_t first = index(k - 1, 0, 2 * v + IVec3(c & 1, (c >> 1) & 1, (c >> 2) & 1));
+                            for (int f = 0; f < kFaceCount; ++f)
+                                children[size_t(f)][size_t(c)] = from_half_rgba(fine[first + size_t(f)]);
                         }
+                        const size_t out = index(k, 0, v);
+                        for (int f = 0; f < kFaceCount; ++f)
+                            coarse[out + size_t(f)] = to_half_rgba(downsample_face(f, children[size_t(f)]));
+                    }
+        });
+    }
+}
+
+void DenseMipTexture::refresh_occupancy(const std::vector<std::vector<HalfRGBA>>& buffer) {
+    for (int k = 0; k < level_count(); ++k) {
+        const int r = resolution(k);
+        const std::vector<HalfRGBA>& cells = buffer[size_t(k)];
+        std::vector<uint8_t>& out = occupancy_[size_t(k)];
+        const size_t texels = out.size();
+        std::vector<uint8_t> any(texels, 0);
+        parallel_for(texels, size_t(1) << 14, [&](size_t b, size_t e) {
+            for (size_t t = b; t < e; ++t)
+                for (int f = 0; f < kFaceCount; ++f)
+                    if (has_opacity(cells[t * kFaceCount + size_t(f)])) {
+                        any[t] = 1;
+                        break;
+                    }
+        });
+        // A sample at the upper border reads its border texel twice: no neighbour beyond.
+        parallel_for(size_t(r), 1, [&](size_t z0, size_t z1) {
+            for (int z = int(z0); z < int(z1); ++z)
+                for (int y = 0; y < r; ++y)
+                    for (int x = 0; x < r; ++x) {
+                        uint8_t o = 0;
+                        for (int c = 0; c < 8; ++c) {
+                            const int tx = std::min(x + (c & 1), r - 1), ty = std::min(y + ((c >> 1) & 1), r - 1),
+                                      tz = std::min(z + (c >> 2), r - 1);
+                            o |= any[(size_t(tz) * size_t(r) + size_t(ty)) * size_t(r) + size_t(tx)];
+                        }
+                        out[(size_t(z) * size_t(r) + size_t(y)) * size_t(r) + size_t(x)] = o;
                     }
         });
     }
@@ -81,8 +119,9 @@ void DenseMipTexture::build_mips(std::vector<std::vector<Vec4>>& buffer) const {
 
 size_t DenseMipTexture::radiance_bytes() const {
     size_t bytes = 0;
-    for (const auto& l : direct) bytes += l.size() * sizeof(Vec4);
-    for (const auto& l : radiance) bytes += l.size() * sizeof(Vec4);
+    for (const auto& l : direct) bytes += l.size() * sizeof(HalfRGBA);
+    for (const auto& l : radiance) bytes += l.size() * sizeof(HalfRGBA);
+    for (const auto& l : occupancy_) bytes += l.size();
     return bytes;
 }
 

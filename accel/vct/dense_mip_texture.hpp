@@ -4,7 +4,8 @@
 // with the same six faces per voxel as the cascades; level k has N/2^k voxels per axis
 // and is filtered from level k − 1 with the same anisotropic 2×2×2 → 1 filter
 // (front-to-back along the face's axis, accel/vct/anisotropic_voxel.hpp). Each level of a
-// buffer is one allocation laid out [face][z][y][x].
+// buffer is one allocation of RGBA16F texels laid out [z][y][x][face], as the cascades'
+// levels (accel/vct/cascaded_voxel_texture.hpp), and has the same occupancy map.
 //
 // The G-buffer stays sparse (the occupied voxels as a list): a dense G-buffer of five
 // attributes × six faces would not fit at the sizes the baseline runs at.
@@ -12,6 +13,7 @@
 #include <vector>
 #include "accel/vct/anisotropic_voxel.hpp"
 #include "accel/vct/fragment_voxelizer.hpp"
+#include "accel/vct/half_rgba.hpp"
 #include "core/util/math.hpp"
 
 namespace gilab {
@@ -37,7 +39,7 @@ public:
     VoxelBox region() const { return {IVec3(0), IVec3(config_.resolution)}; }
     size_t index(int level, int face, const IVec3& v) const {
         const size_t r = size_t(resolution(level));
-        return size_t(face) * r * r * r + (size_t(v.z) * r + size_t(v.y)) * r + size_t(v.x);
+        return ((size_t(v.z) * r + size_t(v.y)) * r + size_t(v.x)) * size_t(kFaceCount) + size_t(face);
     }
     size_t cells(int level) const {
         const size_t r = size_t(resolution(level));
@@ -47,21 +49,27 @@ public:
     // Replaces the G-buffer by voxelizing the whole grid.
     FragmentVoxelizeStats voxelize(const FragmentVoxelizer& voxelizer);
     // Zeroes level 0 of a buffer, then the caller writes occupied voxels into it.
-    static void clear_level0(std::vector<std::vector<Vec4>>& buffer);
+    static void clear_level0(std::vector<std::vector<HalfRGBA>>& buffer);
     // Levels 1.. of a buffer from level 0.
-    void build_mips(std::vector<std::vector<Vec4>>& buffer) const;
+    void build_mips(std::vector<std::vector<HalfRGBA>>& buffer) const;
+    // Per level and texel t: whether any face of the 2×2×2 texels from t up has opacity
+    // in `buffer` (what one trilinear sample reads; 0: the sample is skipped). All 1
+    // until the first refresh; both buffers carry the same opacity.
+    void refresh_occupancy(const std::vector<std::vector<HalfRGBA>>& buffer);
+    const uint8_t* occupancy(int level) const { return occupancy_[size_t(level)].data(); }
 
     size_t voxel_count() const { return size_t(config_.resolution) * config_.resolution * config_.resolution; }
-    size_t radiance_bytes() const;
+    size_t radiance_bytes() const;  // both radiance buffers and the occupancy maps
     size_t gbuffer_bytes() const { return voxels.capacity() * sizeof(AnisotropicVoxel); }
     size_t bytes() const { return radiance_bytes() + gbuffer_bytes(); }
 
     std::vector<AnisotropicVoxel> voxels;       // sparse G-buffer, (z, y, x) order
-    std::vector<std::vector<Vec4>> direct;      // per level, premultiplied RGBA
-    std::vector<std::vector<Vec4>> radiance;    // per level, direct + voxel bounce
+    std::vector<std::vector<HalfRGBA>> direct;      // per level, premultiplied RGBA16F
+    std::vector<std::vector<HalfRGBA>> radiance;    // per level, direct + voxel bounce
 
 private:
     DenseMipConfig config_;
+    std::vector<std::vector<uint8_t>> occupancy_;   // per level, see refresh_occupancy
 };
 
 }  // namespace gilab

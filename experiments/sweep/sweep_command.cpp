@@ -157,7 +157,11 @@ int show_status(const Sweep& sweep, std::ostream& out) {
 }
 
 int resume(Sweep sweep, const SweepCommand& c, std::ostream& out, std::ostream& err) {
-    if (sweep.on == "local") return run_sweep_locally(sweep, c.local, out, err);
+    if (sweep.on == "local") {
+        LocalSweepOptions local = c.local;
+        local.threads = c.threads;  // `gilab --threads T sweep resume DIR`: T threads per task, as when started
+        return run_sweep_locally(sweep, local, out, err);
+    }
     const std::vector<SweepTask> pending = tasks_without_result(sweep);
     if (pending.empty()) {
         out << "every task has a result; merging here" << std::endl;

@@ -1,135 +1,213 @@
 #include "techniques/vct/cone_tracer.hpp"
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include "core/util/error.hpp"
 
 namespace gilab {
 
-VoxelConeView VoxelConeView::cascade(const CascadedVoxelTexture& t, const std::vector<Vec4>& buffer) {
-    if (buffer.size() != t.cell_count()) throw Error("cone tracer", "radiance buffer does not match the cascade texture");
+VoxelConeView VoxelConeView::of_levels(const Vec3& anchor, bool nested, std::vector<ConeLevel> levels) {
     VoxelConeView view;
-    view.anchor_ = Vec3(t.config().anchor);
-    view.nested_ = true;
-    const int R = t.resolution();
-    for (int k = 0; k < t.levels(); ++k) {
-        ConeLevel l;
-        l.data = buffer.data() + t.index(0, k, UVec3(0));
-        l.face_stride = size_t(R);
-        l.row_stride = t.width();
-        l.slice_stride = t.width() * t.height();
-        l.origin = t.origin(k);
-        l.size = R;
-        l.texel_base = IVec3(0);
-        l.wrap_mask = R - 1;
-        l.voxel_size = float(t.voxel_size(k));
-        l.inv_voxel_size = float(1.0 / t.voxel_size(k));
-        view.levels_.push_back(l);
-    }
+    view.anchor_ = anchor;
+    view.nested_ = nested;
+    view.levels_ = std::move(levels);
     return view;
 }
 
-VoxelConeView VoxelConeView::dense(const DenseMipTexture& t, const std::vector<std::vector<Vec4>>& buffer) {
+VoxelConeView VoxelConeView::cascade(const CascadedVoxelTexture& t, const std::vector<HalfRGBA>& buffer) {
+    if (buffer.size() != t.cell_count()) throw Error("cone tracer", "radiance buffer does not match the cascade texture");
+    const int R = t.resolution();
+    std::vector<ConeLevel> levels;
+    for (int k = 0; k < t.levels(); ++k) {
+        ConeLevel l;
+        l.data = buffer.data() + t.index(0, k, UVec3(0));
+        l.occupancy = t.occupancy(k);
+        l.face_stride = 1;
+        l.x_stride = kFaceCount;
+        l.row_stride = size_t(R) * kFaceCount;
+        l.slice_stride = size_t(R) * size_t(R) * kFaceCount;
+        l.occupancy_row = size_t(R);
+        l.occupancy_slice = size_t(R) * size_t(R);
+        l.origin = t.origin(k);
+        l.size = R;
+        l.wrap_mask = R - 1;
+        l.voxel_size = float(t.voxel_size(k));
+        l.inv_voxel_size = float(1.0 / t.voxel_size(k));
+        levels.push_back(l);
+    }
+    return of_levels(Vec3(t.config().anchor), true, std::move(levels));
+}
+
+VoxelConeView VoxelConeView::dense(const DenseMipTexture& t, const std::vector<std::vector<HalfRGBA>>& buffer) {
     if (int(buffer.size()) != t.level_count()) throw Error("cone tracer", "radiance buffer does not match the mip chain");
-    VoxelConeView view;
-    view.anchor_ = Vec3(t.config().anchor);
-    view.nested_ = false;
+    std::vector<ConeLevel> levels;
     for (int k = 0; k < t.level_count(); ++k) {
         const size_t r = size_t(t.resolution(k));
         ConeLevel l;
         l.data = buffer[size_t(k)].data();
-        l.face_stride = r * r * r;
-        l.row_stride = r;
-        l.slice_stride = r * r;
+        l.occupancy = t.occupancy(k);
+        l.face_stride = 1;
+        l.x_stride = kFaceCount;
+        l.row_stride = r * kFaceCount;
+        l.slice_stride = r * r * kFaceCount;
+        l.occupancy_row = r;
+        l.occupancy_slice = r * r;
         l.origin = IVec3(0);
         l.size = int(r);
-        l.texel_base = IVec3(0);
         l.wrap_mask = -1;
         l.voxel_size = float(t.voxel_size(k));
         l.inv_voxel_size = float(1.0 / t.voxel_size(k));
-        view.levels_.push_back(l);
+        levels.push_back(l);
     }
-    return view;
+    return of_levels(Vec3(t.config().anchor), false, std::move(levels));
 }
 
-int VoxelConeView::finest_level_containing(const Vec3& p, float margin) const {
-    const int n = nested_ ? level_count() : std::min(level_count(), 1);
-    for (int k = 0; k < n; ++k) {
-        const ConeLevel& l = levels_[size_t(k)];
-        Vec3 q = (p - anchor_) * l.inv_voxel_size - Vec3(l.origin);
-        const float hi = float(l.size) - margin;
-        if (q.x >= margin && q.y >= margin && q.z >= margin && q.x < hi && q.y < hi && q.z < hi) return k;
-    }
+int VoxelConeView::level_containing(const Vec3& p, int from, float margin) const {
+    const int n = level_count();
+    if (n == 0) return -1;
+    from = std::clamp(from, 0, n - 1);
+    if (!nested_) return contains(levels_[0], p, margin) ? from : -1;
+    // If `from` holds p, the finest level holding p is `from` or a finer one: either way
+    // the answer is `from`.
+    if (contains(levels_[size_t(from)], p, margin)) return from;
+    for (int k = 0; k < n; ++k)
+        if (contains(levels_[size_t(k)], p, margin)) return std::max(k, from);
     return -1;
 }
 
-Vec4 VoxelConeView::sample_level(int level, const Vec3& p, const FaceWeights& faces, const Vec4* plane) const {
-    const ConeLevel& l = levels_[size_t(level)];
-    Vec3 q = (p - anchor_) * l.inv_voxel_size;
+namespace {
+
+// The eight texels of one trilinear sample: cell offsets along x, y, z and the weights.
+struct SampleCorners {
+    IVec3 i0, i1;               // lower and upper voxel (world voxel coordinates of the level)
+    size_t x[2], y[2], z[2];    // cell offsets
+    float wx[2], wy[2], wz[2];
+    size_t occupancy;           // texel of i0 in the occupancy map
+};
+
+SampleCorners corners_of(const ConeLevel& l, const Vec3& q_unclamped) {
+    SampleCorners c;
     const Vec3 lo = Vec3(l.origin) + Vec3(0.5f), hi = Vec3(l.origin + IVec3(l.size)) - Vec3(0.5f);
-    q = glm::clamp(q, lo, hi) - Vec3(0.5f);
+    const Vec3 q = glm::clamp(q_unclamped, lo, hi) - Vec3(0.5f);
     const Vec3 fl = glm::floor(q);
     const Vec3 t = q - fl;
-    IVec3 i0(int(fl.x), int(fl.y), int(fl.z));
-    IVec3 i1 = glm::min(i0 + IVec3(1), l.origin + IVec3(l.size - 1));
-    const IVec3 a = (i0 - l.texel_base) & IVec3(l.wrap_mask);
-    const IVec3 b = (i1 - l.texel_base) & IVec3(l.wrap_mask);
-    const size_t x[2] = {size_t(a.x), size_t(b.x)};
-    const size_t y[2] = {size_t(a.y) * l.row_stride, size_t(b.y) * l.row_stride};
-    const size_t z[2] = {size_t(a.z) * l.slice_stride, size_t(b.z) * l.slice_stride};
-    const float wx[2] = {1.0f - t.x, t.x}, wy[2] = {1.0f - t.y, t.y}, wz[2] = {1.0f - t.z, t.z};
+    c.i0 = IVec3(int(fl.x), int(fl.y), int(fl.z));
+    c.i1 = glm::min(c.i0 + IVec3(1), l.origin + IVec3(l.size - 1));
+    const IVec3 a = c.i0 & IVec3(l.wrap_mask);
+    const IVec3 b = c.i1 & IVec3(l.wrap_mask);
+    c.x[0] = size_t(a.x) * l.x_stride;
+    c.x[1] = size_t(b.x) * l.x_stride;
+    c.y[0] = size_t(a.y) * l.row_stride;
+    c.y[1] = size_t(b.y) * l.row_stride;
+    c.z[0] = size_t(a.z) * l.slice_stride;
+    c.z[1] = size_t(b.z) * l.slice_stride;
+    c.wx[0] = 1.0f - t.x;
+    c.wx[1] = t.x;
+    c.wy[0] = 1.0f - t.y;
+    c.wy[1] = t.y;
+    c.wz[0] = 1.0f - t.z;
+    c.wz[1] = t.z;
+    c.occupancy = size_t(a.z) * l.occupancy_slice + size_t(a.y) * l.occupancy_row + size_t(a.x);
+    return c;
+}
+
+// Σ over the eight texels and the three faces of weight(texel, face) × value, where a
+// texel's weight is its trilinear weight × keep[face][texel]. RGBA16F values are read as
+// their bits shifted up by 13 (see half_rgba.hpp) and the weights carry 2^112.
+template <bool kClip>
+Vec4 accumulate(const ConeLevel& l, const SampleCorners& c, const FaceWeights& faces, const float (*keep)[8]) {
+    size_t face_offset[3];
+    for (int i = 0; i < 3; ++i) face_offset[i] = size_t(faces.face[size_t(i)]) * l.face_stride;
+#if defined(__SSE2__)
+    __m128 acc[3] = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()};
+    for (int k = 0; k < 8; ++k) {
+        const HalfRGBA* cell = l.data + c.z[k >> 2] + c.y[(k >> 1) & 1] + c.x[k & 1];
+        const float w = (c.wz[k >> 2] * c.wy[(k >> 1) & 1]) * c.wx[k & 1] * kHalfBitsScale;
+        for (int i = 0; i < 3; ++i) {
+            const __m128 wk = _mm_set1_ps(kClip ? w * keep[i][k] : w);
+            __m128i bits = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(cell + face_offset[i]));
+            bits = _mm_slli_epi32(_mm_unpacklo_epi16(bits, _mm_setzero_si128()), 13);
+            acc[i] = _mm_add_ps(acc[i], _mm_mul_ps(_mm_castsi128_ps(bits), wk));
+        }
+    }
+    __m128 sum = _mm_mul_ps(acc[0], _mm_set1_ps(faces.weight[0]));
+    sum = _mm_add_ps(sum, _mm_mul_ps(acc[1], _mm_set1_ps(faces.weight[1])));
+    sum = _mm_add_ps(sum, _mm_mul_ps(acc[2], _mm_set1_ps(faces.weight[2])));
+    alignas(16) float out[4];
+    _mm_store_ps(out, sum);
+    return {out[0], out[1], out[2], out[3]};
+#else
+    Vec4 acc[3] = {Vec4(0.0f), Vec4(0.0f), Vec4(0.0f)};
+    for (int k = 0; k < 8; ++k) {
+        const HalfRGBA* cell = l.data + c.z[k >> 2] + c.y[(k >> 1) & 1] + c.x[k & 1];
+        const float w = (c.wz[k >> 2] * c.wy[(k >> 1) & 1]) * c.wx[k & 1] * kHalfBitsScale;
+        for (int i = 0; i < 3; ++i) {
+            const HalfRGBA& h = cell[face_offset[i]];
+            const Vec4 bits(std::bit_cast<float>(uint32_t(h.c[0]) << 13), std::bit_cast<float>(uint32_t(h.c[1]) << 13),
+                            std::bit_cast<float>(uint32_t(h.c[2]) << 13), std::bit_cast<float>(uint32_t(h.c[3]) << 13));
+            acc[i] += bits * (kClip ? w * keep[i][k] : w);
+        }
+    }
+    return acc[0] * faces.weight[0] + acc[1] * faces.weight[1] + acc[2] * faces.weight[2];
+#endif
+}
+
+}  // namespace
+
+Vec4 VoxelConeView::sample_level(int level, const Vec3& p, const FaceWeights& faces, const Vec4* plane) const {
+    const ConeLevel& l = levels_[size_t(level)];
+    const SampleCorners c = corners_of(l, (p - anchor_) * l.inv_voxel_size);
+    if (l.occupancy && !l.occupancy[c.occupancy]) return Vec4(0.0f);  // all eight texels empty
+    if (!plane) return accumulate<false>(l, c, faces, nullptr);
     // Clip plane: voxels entirely behind it are empty; voxels it cuts hold the cone's own
     // surface, so their faces turned away from the plane (the surface's back side, seen
     // only through the wide trilinear footprint of a coarse level) are skipped.
     float keep_back[8] = {1, 1, 1, 1, 1, 1, 1, 1}, keep_front[8] = {1, 1, 1, 1, 1, 1, 1, 1};
-    bool face_front[3] = {true, true, true};
-    if (plane) {
-        const Vec3 n(*plane);
-        // A hair more than half a voxel, so a surface lying on a voxel face counts as cut.
-        const float half = 0.501f * l.voxel_size * (std::abs(n.x) + std::abs(n.y) + std::abs(n.z));
-        const IVec3 i[2] = {i0, i1};
-        float sx[2], sy[2], sz[2];
-        for (int k = 0; k < 2; ++k) {
-            sx[k] = n.x * (anchor_.x + (float(i[k].x) + 0.5f) * l.voxel_size);
-            sy[k] = n.y * (anchor_.y + (float(i[k].y) + 0.5f) * l.voxel_size);
-            sz[k] = n.z * (anchor_.z + (float(i[k].z) + 0.5f) * l.voxel_size);
-        }
-        for (int c = 0; c < 8; ++c) {
-            const float s = sx[c & 1] + sy[(c >> 1) & 1] + sz[c >> 2] - plane->w;
-            if (s + half <= 0.0f) keep_back[c] = keep_front[c] = 0.0f;  // behind
-            else if (s - half <= 0.0f) keep_back[c] = 0.0f;              // cut
-        }
-        for (int i = 0; i < 3; ++i) face_front[i] = glm::dot(face_direction(faces.face[size_t(i)]), n) >= -1e-6f;
+    const Vec3 n(*plane);
+    // A hair more than half a voxel, so a surface lying on a voxel face counts as cut.
+    const float half = 0.501f * l.voxel_size * (std::abs(n.x) + std::abs(n.y) + std::abs(n.z));
+    const IVec3 i[2] = {c.i0, c.i1};
+    float sx[2], sy[2], sz[2];
+    for (int k = 0; k < 2; ++k) {
+        sx[k] = n.x * (anchor_.x + (float(i[k].x) + 0.5f) * l.voxel_size);
+        sy[k] = n.y * (anchor_.y + (float(i[k].y) + 0.5f) * l.voxel_size);
+        sz[k] = n.z * (anchor_.z + (float(i[k].z) + 0.5f) * l.voxel_size);
     }
-    Vec4 sum(0.0f);
-    for (int i = 0; i < 3; ++i) {
-        const float fw = faces.weight[size_t(i)];
-        if (fw <= 0.0f) continue;
-        const Vec4* base = l.data + size_t(faces.face[size_t(i)]) * l.face_stride;
-        const float* keep = face_front[i] ? keep_front : keep_back;
-        Vec4 s(0.0f);
-        for (int dz = 0; dz < 2; ++dz)
-            for (int dy = 0; dy < 2; ++dy) {
-                const Vec4* row = base + z[dz] + y[dy];
-                const float w = wz[dz] * wy[dy];
-                const int c = 2 * dy + 4 * dz;
-                s += (w * wx[0] * keep[c]) * row[x[0]] + (w * wx[1] * keep[c + 1]) * row[x[1]];
-            }
-        sum += fw * s;
+    for (int k = 0; k < 8; ++k) {
+        const float s = sx[k & 1] + sy[(k >> 1) & 1] + sz[k >> 2] - plane->w;
+        if (s + half <= 0.0f) keep_back[k] = keep_front[k] = 0.0f;  // behind
+        else if (s - half <= 0.0f) keep_back[k] = 0.0f;              // cut
     }
-    return sum;
+    float keep[3][8];
+    for (int f = 0; f < 3; ++f) {
+        const bool front = glm::dot(face_direction(faces.face[size_t(f)]), n) >= -1e-6f;
+        std::copy_n(front ? keep_front : keep_back, 8, keep[f]);
+    }
+    return accumulate<true>(l, c, faces, keep);
 }
 
 ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOptions& options) {
     ConeResult r;
     const int n = view.level_count();
     if (n == 0) return r;
-    const float w0 = view.base_voxel_size();
+    const float w0 = view.base_voxel_size(), inv_w0 = 1.0f / w0;
+    const float coarsest = view.level(n - 1).voxel_size;
+    const float bias_scale = std::exp2(options.lod_bias);
     const FaceWeights faces = faces_seen_along(cone.direction);
+    const Vec4* plane = options.clip ? &options.clip_plane : nullptr;
+    // A sample farther in front of the clip plane than its eight voxel centres reach (one
+    // voxel per axis) plus sample_level's half-voxel test is never clipped; blending also
+    // reads the next level, of twice the voxel.
+    const float plane_reach = plane ? 1.502f * (options.blend_levels ? 2.0f : 1.0f) *
+                                          (std::abs(plane->x) + std::abs(plane->y) + std::abs(plane->z))
+                                    : 0.0f;
     float dist = options.start;
     while (dist < options.max_distance) {
         const Vec3 p = cone.origin + dist * cone.direction;
-        const int finest = view.finest_level_containing(p, 1.0f);
-        if (finest < 0) break;  // left the structure
         const float diameter = std::max(2.0f * cone.tan_half_angle * dist, w0);
         if (!options.bounds.empty()) {
             // The footprint has left the box (convex): nothing further along is met.
@@ -137,14 +215,22 @@ ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOpt
             const Vec3 lo = options.bounds.min - grow, hi = options.bounds.max + grow;
             if (p.x < lo.x || p.y < lo.y || p.z < lo.z || p.x > hi.x || p.y > hi.y || p.z > hi.z) break;
         }
-        const float level = std::min(std::max(cone_level(diameter, w0) + options.lod_bias, float(finest)), float(n - 1));
-        const int l0 = int(level);
-        const float frac = level - float(l0);
-        const Vec4* plane = options.clip ? &options.clip_plane : nullptr;
-        Vec4 s = view.sample_level(l0, p, faces, plane);
-        if (options.blend_levels && frac > 0.0f && l0 + 1 < n)
-            s = glm::mix(s, view.sample_level(l0 + 1, p, faces, plane), frac);
-        const float voxel = w0 * std::exp2(level);
+        // Eq. 2: the voxel width matching the footprint, w0·2^lod (lod continuous, with
+        // the bias), read at level max(⌊lod⌋, finest level holding p), at most the coarsest.
+        const float lod_width = diameter * bias_scale;
+        const float ratio = lod_width * inv_w0;
+        const int lod = ratio < 1.0f ? 0 : int((std::bit_cast<uint32_t>(ratio) >> 23) & 0xffu) - 127;
+        const int l0 = view.level_containing(p, lod, 1.0f);
+        if (l0 < 0) break;  // left the structure
+        // The continuous level's voxel: the footprint's own width unless p is held only by
+        // a coarser level (then that level's voxel) or beyond the coarsest.
+        const float voxel = l0 > lod ? view.level(l0).voxel_size : std::clamp(lod_width, w0, coarsest);
+        const Vec4* clip = plane && glm::dot(Vec3(*plane), p) - plane->w <= plane_reach * voxel ? plane : nullptr;
+        Vec4 s = view.sample_level(l0, p, faces, clip);
+        if (options.blend_levels && l0 + 1 < n) {
+            const float frac = std::log2(voxel / view.level(l0).voxel_size);
+            if (frac > 0.0f) s = glm::mix(s, view.sample_level(l0 + 1, p, faces, clip), frac);
+        }
         const float step = voxel * options.step;  // the sampled level's voxel: never skips over it
         ++r.samples;
         if (s.a > 1e-6f) {

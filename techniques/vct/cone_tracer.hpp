@@ -26,17 +26,19 @@
 #include "accel/vct/anisotropic_voxel.hpp"
 #include "accel/vct/cascaded_voxel_texture.hpp"
 #include "accel/vct/dense_mip_texture.hpp"
+#include "accel/vct/half_rgba.hpp"
 #include "core/util/math.hpp"
 
 namespace gilab {
 
 // One level of a voxel structure as the cone tracer reads it.
 struct ConeLevel {
-    const Vec4* data = nullptr;     // cell of face 0, texel (0, 0, 0)
-    size_t face_stride = 0, row_stride = 0, slice_stride = 0;  // x stride is 1
+    const HalfRGBA* data = nullptr; // cell of face 0, texel (0, 0, 0)
+    const uint8_t* occupancy = nullptr;  // per texel, see CascadedVoxelTexture::refresh_occupancy
+    size_t face_stride = 1, x_stride = kFaceCount, row_stride = 0, slice_stride = 0;  // in cells
+    size_t occupancy_row = 0, occupancy_slice = 0;  // in texels (x stride 1)
     IVec3 origin{0};                // region [origin, origin + size)
     int size = 0;
-    IVec3 texel_base{0};            // texel = (v − texel_base) & wrap_mask
     int wrap_mask = -1;             // R − 1 for toroidal storage, all ones for linear
     float voxel_size = 1, inv_voxel_size = 1;
 };
@@ -44,19 +46,31 @@ struct ConeLevel {
 // A read-only view of one radiance buffer of a cascade texture or a dense mip chain.
 class VoxelConeView {
 public:
-    static VoxelConeView cascade(const CascadedVoxelTexture& texture, const std::vector<Vec4>& buffer);
-    static VoxelConeView dense(const DenseMipTexture& texture, const std::vector<std::vector<Vec4>>& buffer);
+    static VoxelConeView cascade(const CascadedVoxelTexture& texture, const std::vector<HalfRGBA>& buffer);
+    static VoxelConeView dense(const DenseMipTexture& texture, const std::vector<std::vector<HalfRGBA>>& buffer);
+    // Any layout: levels as given (nested: each level has its own region, cascades).
+    static VoxelConeView of_levels(const Vec3& anchor, bool nested, std::vector<ConeLevel> levels);
 
     int level_count() const { return int(levels_.size()); }
     float base_voxel_size() const { return levels_.empty() ? 1.0f : levels_[0].voxel_size; }
     const ConeLevel& level(int k) const { return levels_[size_t(k)]; }
     // Finest level whose region holds p at least `margin` voxels inside; -1 if none.
-    int finest_level_containing(const Vec3& p, float margin = 1.0f) const;
+    int finest_level_containing(const Vec3& p, float margin = 1.0f) const {
+        return level_containing(p, 0, margin);
+    }
+    // The finest level from `from` up whose region holds p `margin` voxels inside (the
+    // mips of a dense texture share level 0's region); -1 if none.
+    int level_containing(const Vec3& p, int from, float margin = 1.0f) const;
     // Trilinear, face-weighted sample of one level (position clamped into the level).
     // With a plane (n, d), voxels whose box reaches n·x ≤ d count as empty.
     Vec4 sample_level(int level, const Vec3& p, const FaceWeights& faces, const Vec4* plane = nullptr) const;
 
 private:
+    bool contains(const ConeLevel& l, const Vec3& p, float margin) const {
+        const Vec3 q = (p - anchor_) * l.inv_voxel_size - Vec3(l.origin);
+        const float hi = float(l.size) - margin;
+        return q.x >= margin && q.y >= margin && q.z >= margin && q.x < hi && q.y < hi && q.z < hi;
+    }
     Vec3 anchor_{0};
     bool nested_ = true;            // cascades: each level has its own region; mips share one
     std::vector<ConeLevel> levels_;
@@ -83,7 +97,7 @@ struct ConeOptions {
     bool clip = false;
     Vec4 clip_plane{0};
     // The scene's bounding box: a cone whose footprint has left it sees nothing more.
-    Bounds3 bounds;   // α' = 1 − (1 − α)^(step / voxel); off: eq. 3 as printed
+    Bounds3 bounds;
 };
 
 struct ConeResult {

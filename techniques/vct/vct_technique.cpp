@@ -347,22 +347,24 @@ void VctTechnique::light_cascade(const std::vector<bool>& levels) {
             if (!inner.contains(v)) own.push_back(v);
         return own;
     };
-    auto clear_own = [&](int k, std::vector<Vec4>& buffer) {
+    auto clear_own = [&](int k, std::vector<HalfRGBA>& buffer) {
         const VoxelBox box = t.region(k), inner = t.inner_box(k);
         for (int z = box.begin.z; z < box.end.z; ++z)
             for (int y = box.begin.y; y < box.end.y; ++y)
                 for (int x = box.begin.x; x < box.end.x; ++x) {
                     IVec3 v(x, y, z);
                     if (inner.contains(v)) continue;
-                    for (int f = 0; f < kFaceCount; ++f) buffer[t.index_of_voxel(f, k, v)] = Vec4(0);
+                    for (int f = 0; f < kFaceCount; ++f) buffer[t.index_of_voxel(f, k, v)] = HalfRGBA{};
                 }
     };
     std::vector<std::vector<IVec3>> own(size_t(t.levels()));
     for (int k = 0; k < t.levels(); ++k)
         if (levels[size_t(k)]) own[size_t(k)] = own_voxels(k);
+    // The direct light of each own voxel at full precision, for its bounce.
+    std::vector<std::vector<VoxelRadiance>> own_direct(size_t(t.levels()));
 
     // The anisotropic filter of one level, timed and counted (cells written).
-    auto filter = [&](int k, std::vector<Vec4>& buffer) {
+    auto filter = [&](int k, std::vector<HalfRGBA>& buffer) {
         Stopwatch watch;
         t.downsample(k, buffer);
         filter_ms += watch.elapsed_ms();
@@ -375,12 +377,15 @@ void VctTechnique::light_cascade(const std::vector<bool>& levels) {
         Stopwatch watch;
         clear_own(k, t.direct);
         const auto& list = own[size_t(k)];
+        auto& values = own_direct[size_t(k)];
+        values.resize(list.size());
         const float voxel = float(t.voxel_size(k));
         parallel_for(list.size(), 16, [&](size_t b, size_t e) {
             uint64_t local = 0;
             for (size_t i = b; i < e; ++i) {
-                VoxelRadiance r = shading.direct(input_of(t, k, list[i]), k, list[i], voxel, local);
-                for (int f = 0; f < kFaceCount; ++f) t.direct[t.index_of_voxel(f, k, list[i])] = r[size_t(f)];
+                values[i] = shading.direct(input_of(t, k, list[i]), k, list[i], voxel, local);
+                const size_t first = t.index_of_voxel(0, k, list[i]);
+                for (int f = 0; f < kFaceCount; ++f) t.direct[first + size_t(f)] = to_half_rgba(values[i][size_t(f)]);
             }
             faces_lit += local;
         });
@@ -388,6 +393,9 @@ void VctTechnique::light_cascade(const std::vector<bool>& levels) {
         direct_ms += watch.elapsed_ms();
         filter(k, t.direct);
     }
+    // Cones skip what holds no opacity (the same in both buffers).
+    for (int k = 0; k < t.levels(); ++k)
+        if (levels[size_t(k)]) t.refresh_occupancy(k, t.direct);
     // Voxel bounce from the direct V-buffer.
     const VoxelConeView view = VoxelConeView::cascade(t, t.direct);
     for (int k = 0; k < t.levels(); ++k) {
@@ -395,16 +403,16 @@ void VctTechnique::light_cascade(const std::vector<bool>& levels) {
         Stopwatch watch;
         clear_own(k, t.radiance);
         const auto& list = own[size_t(k)];
+        const auto& values = own_direct[size_t(k)];
         const float voxel = float(t.voxel_size(k));
         parallel_for(list.size(), 4, [&](size_t b, size_t e) {
             uint64_t local = 0;
             for (size_t i = b; i < e; ++i) {
-                VoxelRadiance d;
-                for (int f = 0; f < kFaceCount; ++f) d[size_t(f)] = t.direct[t.index_of_voxel(f, k, list[i])];
-                VoxelRadiance r = settings_.second_bounce
-                                      ? shading.bounce(input_of(t, k, list[i]), d, view, voxel, local)
-                                      : d;
-                for (int f = 0; f < kFaceCount; ++f) t.radiance[t.index_of_voxel(f, k, list[i])] = r[size_t(f)];
+                const VoxelRadiance r = settings_.second_bounce
+                                            ? shading.bounce(input_of(t, k, list[i]), values[i], view, voxel, local)
+                                            : values[i];
+                const size_t first = t.index_of_voxel(0, k, list[i]);
+                for (int f = 0; f < kFaceCount; ++f) t.radiance[first + size_t(f)] = to_half_rgba(r[size_t(f)]);
             }
             cones += local;
         });
@@ -430,17 +438,20 @@ void VctTechnique::light_dense() {
     double filter_ms = 0;
     Stopwatch watch;
     DenseMipTexture::clear_level0(t.direct);
+    std::vector<VoxelRadiance> values(list.size());  // full precision, for the bounce
     parallel_for(list.size(), 16, [&](size_t b, size_t e) {
         uint64_t local = 0;
         for (size_t i = b; i < e; ++i) {
-            VoxelRadiance r = shading.direct(input_of(list[i]), 0, list[i].coord, voxel, local);
-            for (int f = 0; f < kFaceCount; ++f) t.direct[0][t.index(0, f, list[i].coord)] = r[size_t(f)];
+            values[i] = shading.direct(input_of(list[i]), 0, list[i].coord, voxel, local);
+            const size_t first = t.index(0, 0, list[i].coord);
+            for (int f = 0; f < kFaceCount; ++f) t.direct[0][first + size_t(f)] = to_half_rgba(values[i][size_t(f)]);
         }
         faces_lit += local;
     });
     const double direct_ms = watch.elapsed_ms();
     watch.reset();
     t.build_mips(t.direct);
+    t.refresh_occupancy(t.direct);  // cones skip what holds no opacity (the same in both buffers)
     filter_ms += watch.elapsed_ms();
     watch.reset();
     const VoxelConeView view = VoxelConeView::dense(t, t.direct);
@@ -449,10 +460,10 @@ void VctTechnique::light_dense() {
     parallel_for(list.size(), 4, [&](size_t b, size_t e) {
         uint64_t local = 0;
         for (size_t i = b; i < e; ++i) {
-            VoxelRadiance d;
-            for (int f = 0; f < kFaceCount; ++f) d[size_t(f)] = t.direct[0][t.index(0, f, list[i].coord)];
-            VoxelRadiance r = settings_.second_bounce ? shading.bounce(input_of(list[i]), d, view, voxel, local) : d;
-            for (int f = 0; f < kFaceCount; ++f) t.radiance[0][t.index(0, f, list[i].coord)] = r[size_t(f)];
+            const VoxelRadiance r =
+                settings_.second_bounce ? shading.bounce(input_of(list[i]), values[i], view, voxel, local) : values[i];
+            const size_t first = t.index(0, 0, list[i].coord);
+            for (int f = 0; f < kFaceCount; ++f) t.radiance[0][first + size_t(f)] = to_half_rgba(r[size_t(f)]);
         }
         cones += local;
     });

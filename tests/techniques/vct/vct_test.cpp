@@ -110,7 +110,7 @@ CascadedVoxelTexture constant_levels(float alpha) {
             for (uint32_t y = 0; y < 16; ++y)
                 for (uint32_t x = 0; x < 16; ++x)
                     for (int f = 0; f < kFaceCount; ++f)
-                        t.radiance[t.index(f, k, UVec3(x, y, z))] = Vec4(Vec3(float(k + 1) * alpha), alpha);
+                        t.radiance[t.index(f, k, UVec3(x, y, z))] = to_half_rgba(Vec4(Vec3(float(k + 1) * alpha), alpha));
     return t;
 }
 
@@ -182,7 +182,7 @@ TEST(ConeTracer, EmptySpaceGivesNothingAndAWallSaturates) {
         t.place(k, t.origin_for(DVec3(0.0), k));
         t.voxelize(k, vox);
     }
-    for (size_t i = 0; i < t.cell_count(); ++i) t.radiance[i] = Vec4(Vec3(2.0f * t.opacity[i]), t.opacity[i]);
+    for (size_t i = 0; i < t.cell_count(); ++i) t.radiance[i] = to_half_rgba(Vec4(Vec3(2.0f * t.opacity[i]), t.opacity[i]));
     for (int k = 1; k < 4; ++k) t.downsample(k, t.radiance);
     VoxelConeView view = VoxelConeView::cascade(t, t.radiance);
     for (float tan_beta : {0.05f, 0.3f, 0.6f}) {
@@ -249,7 +249,7 @@ TEST(VctTechnique, DenseMipBaselineAgreesInTheInnermostCascade) {
     size_t compared = 0;
     for (int level = 0; level < 2; ++level) {
         const VoxelBox box = level == 0 ? c.region(0) : c.inner_box(1);
-        const std::vector<Vec4>& mip = d.direct[size_t(level)];
+        const std::vector<HalfRGBA>& mip = d.direct[size_t(level)];
         for (int z = box.begin.z; z < box.end.z; ++z)
             for (int y = box.begin.y; y < box.end.y; ++y)
                 for (int x = box.begin.x; x < box.end.x; ++x) {
@@ -257,7 +257,8 @@ TEST(VctTechnique, DenseMipBaselineAgreesInTheInnermostCascade) {
                     if (glm::any(glm::lessThan(v, IVec3(0))) || glm::any(glm::greaterThanEqual(v, IVec3(d.resolution(level)))))
                         continue;
                     for (int f = 0; f < kFaceCount; ++f) {
-                        Vec4 cv = c.direct[c.index_of_voxel(f, level, v)], dv = mip[d.index(level, f, v)];
+                        const Vec4 cv = from_half_rgba(c.direct[c.index_of_voxel(f, level, v)]);
+                        const Vec4 dv = from_half_rgba(mip[d.index(level, f, v)]);
                         ASSERT_NEAR(cv.a, dv.a, 1e-6f) << "level " << level << " voxel " << x << "," << y << "," << z;
                         ASSERT_NEAR(cv.r, dv.r, 1e-5f * std::max(1.0f, dv.r));
                         compared += cv.a > 0;
