@@ -81,6 +81,12 @@ int VoxelConeView::level_containing(const Vec3& p, int from, float margin) const
 
 namespace {
 
+// floor(x) as an int for |x| < 2^31, without a libm call.
+inline int floor_to_int(float x) {
+    const int i = int(x);
+    return i - int(x < float(i));
+}
+
 // The eight texels of one trilinear sample: cell offsets along x, y, z and the weights.
 struct SampleCorners {
     IVec3 i0, i1;               // lower and upper voxel (world voxel coordinates of the level)
@@ -89,29 +95,27 @@ struct SampleCorners {
     size_t occupancy;           // texel of i0 in the occupancy map
 };
 
+// q: the position in the level's voxel units. Clamped to the centres of the level's
+// border voxels, so a sample never reads outside the level or wraps around.
 SampleCorners corners_of(const ConeLevel& l, const Vec3& q_unclamped) {
     SampleCorners c;
-    const Vec3 lo = Vec3(l.origin) + Vec3(0.5f), hi = Vec3(l.origin + IVec3(l.size)) - Vec3(0.5f);
-    const Vec3 q = glm::clamp(q_unclamped, lo, hi) - Vec3(0.5f);
-    const Vec3 fl = glm::floor(q);
-    const Vec3 t = q - fl;
-    c.i0 = IVec3(int(fl.x), int(fl.y), int(fl.z));
-    c.i1 = glm::min(c.i0 + IVec3(1), l.origin + IVec3(l.size - 1));
-    const IVec3 a = c.i0 & IVec3(l.wrap_mask);
-    const IVec3 b = c.i1 & IVec3(l.wrap_mask);
-    c.x[0] = size_t(a.x) * l.x_stride;
-    c.x[1] = size_t(b.x) * l.x_stride;
-    c.y[0] = size_t(a.y) * l.row_stride;
-    c.y[1] = size_t(b.y) * l.row_stride;
-    c.z[0] = size_t(a.z) * l.slice_stride;
-    c.z[1] = size_t(b.z) * l.slice_stride;
-    c.wx[0] = 1.0f - t.x;
-    c.wx[1] = t.x;
-    c.wy[0] = 1.0f - t.y;
-    c.wy[1] = t.y;
-    c.wz[0] = 1.0f - t.z;
-    c.wz[1] = t.z;
-    c.occupancy = size_t(a.z) * l.occupancy_slice + size_t(a.y) * l.occupancy_row + size_t(a.x);
+    for (int a = 0; a < 3; ++a) {
+        const float lo = float(l.origin[a]), hi = float(l.origin[a] + l.size - 1);
+        const float q = std::min(std::max(q_unclamped[a] - 0.5f, lo), hi);
+        const int i0 = floor_to_int(q);
+        c.i0[a] = i0;
+        c.i1[a] = std::min(i0 + 1, l.origin[a] + l.size - 1);
+        const float t = q - float(i0);
+        const size_t stride = a == 0 ? l.x_stride : a == 1 ? l.row_stride : l.slice_stride;
+        size_t* offset = a == 0 ? c.x : a == 1 ? c.y : c.z;
+        float* w = a == 0 ? c.wx : a == 1 ? c.wy : c.wz;
+        offset[0] = size_t(i0 & l.wrap_mask) * stride;
+        offset[1] = size_t(c.i1[a] & l.wrap_mask) * stride;
+        w[0] = 1.0f - t;
+        w[1] = t;
+    }
+    c.occupancy = size_t(c.i0.z & l.wrap_mask) * l.occupancy_slice + size_t(c.i0.y & l.wrap_mask) * l.occupancy_row +
+                  size_t(c.i0.x & l.wrap_mask);
     return c;
 }
 
@@ -120,39 +124,50 @@ SampleCorners corners_of(const ConeLevel& l, const Vec3& q_unclamped) {
 // their bits shifted up by 13 (see half_rgba.hpp) and the weights carry 2^112.
 template <bool kClip>
 Vec4 accumulate(const ConeLevel& l, const SampleCorners& c, const FaceWeights& faces, const float (*keep)[8]) {
-    size_t face_offset[3];
-    for (int i = 0; i < 3; ++i) face_offset[i] = size_t(faces.face[size_t(i)]) * l.face_stride;
+    const HalfRGBA* face0 = l.data + size_t(faces.face[0]) * l.face_stride;
+    const HalfRGBA* face1 = l.data + size_t(faces.face[1]) * l.face_stride;
+    const HalfRGBA* face2 = l.data + size_t(faces.face[2]) * l.face_stride;
+    float w[8];
+    for (int k = 0; k < 8; ++k) w[k] = (c.wz[k >> 2] * c.wy[(k >> 1) & 1]) * (c.wx[k & 1] * kHalfBitsScale);
 #if defined(__SSE2__)
-    __m128 acc[3] = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()};
+    __m128 a0 = _mm_setzero_ps(), a1 = _mm_setzero_ps(), a2 = _mm_setzero_ps();
+    const __m128i zero = _mm_setzero_si128();
+    auto bits = [&](const HalfRGBA* h) {
+        const __m128i v = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(h));
+        return _mm_castsi128_ps(_mm_slli_epi32(_mm_unpacklo_epi16(v, zero), 13));
+    };
     for (int k = 0; k < 8; ++k) {
-        const HalfRGBA* cell = l.data + c.z[k >> 2] + c.y[(k >> 1) & 1] + c.x[k & 1];
-        const float w = (c.wz[k >> 2] * c.wy[(k >> 1) & 1]) * c.wx[k & 1] * kHalfBitsScale;
-        for (int i = 0; i < 3; ++i) {
-            const __m128 wk = _mm_set1_ps(kClip ? w * keep[i][k] : w);
-            __m128i bits = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(cell + face_offset[i]));
-            bits = _mm_slli_epi32(_mm_unpacklo_epi16(bits, _mm_setzero_si128()), 13);
-            acc[i] = _mm_add_ps(acc[i], _mm_mul_ps(_mm_castsi128_ps(bits), wk));
+        const size_t off = c.z[k >> 2] + c.y[(k >> 1) & 1] + c.x[k & 1];
+        if constexpr (kClip) {
+            a0 = _mm_add_ps(a0, _mm_mul_ps(bits(face0 + off), _mm_set1_ps(w[k] * keep[0][k])));
+            a1 = _mm_add_ps(a1, _mm_mul_ps(bits(face1 + off), _mm_set1_ps(w[k] * keep[1][k])));
+            a2 = _mm_add_ps(a2, _mm_mul_ps(bits(face2 + off), _mm_set1_ps(w[k] * keep[2][k])));
+        } else {
+            const __m128 wk = _mm_set1_ps(w[k]);
+            a0 = _mm_add_ps(a0, _mm_mul_ps(bits(face0 + off), wk));
+            a1 = _mm_add_ps(a1, _mm_mul_ps(bits(face1 + off), wk));
+            a2 = _mm_add_ps(a2, _mm_mul_ps(bits(face2 + off), wk));
         }
     }
-    __m128 sum = _mm_mul_ps(acc[0], _mm_set1_ps(faces.weight[0]));
-    sum = _mm_add_ps(sum, _mm_mul_ps(acc[1], _mm_set1_ps(faces.weight[1])));
-    sum = _mm_add_ps(sum, _mm_mul_ps(acc[2], _mm_set1_ps(faces.weight[2])));
+    __m128 sum = _mm_mul_ps(a0, _mm_set1_ps(faces.weight[0]));
+    sum = _mm_add_ps(sum, _mm_mul_ps(a1, _mm_set1_ps(faces.weight[1])));
+    sum = _mm_add_ps(sum, _mm_mul_ps(a2, _mm_set1_ps(faces.weight[2])));
     alignas(16) float out[4];
     _mm_store_ps(out, sum);
     return {out[0], out[1], out[2], out[3]};
 #else
-    Vec4 acc[3] = {Vec4(0.0f), Vec4(0.0f), Vec4(0.0f)};
+    auto bits = [](const HalfRGBA* h) {
+        return Vec4(std::bit_cast<float>(uint32_t(h->c[0]) << 13), std::bit_cast<float>(uint32_t(h->c[1]) << 13),
+                    std::bit_cast<float>(uint32_t(h->c[2]) << 13), std::bit_cast<float>(uint32_t(h->c[3]) << 13));
+    };
+    Vec4 a0(0.0f), a1(0.0f), a2(0.0f);
     for (int k = 0; k < 8; ++k) {
-        const HalfRGBA* cell = l.data + c.z[k >> 2] + c.y[(k >> 1) & 1] + c.x[k & 1];
-        const float w = (c.wz[k >> 2] * c.wy[(k >> 1) & 1]) * c.wx[k & 1] * kHalfBitsScale;
-        for (int i = 0; i < 3; ++i) {
-            const HalfRGBA& h = cell[face_offset[i]];
-            const Vec4 bits(std::bit_cast<float>(uint32_t(h.c[0]) << 13), std::bit_cast<float>(uint32_t(h.c[1]) << 13),
-                            std::bit_cast<float>(uint32_t(h.c[2]) << 13), std::bit_cast<float>(uint32_t(h.c[3]) << 13));
-            acc[i] += bits * (kClip ? w * keep[i][k] : w);
-        }
+        const size_t off = c.z[k >> 2] + c.y[(k >> 1) & 1] + c.x[k & 1];
+        a0 += bits(face0 + off) * (kClip ? w[k] * keep[0][k] : w[k]);
+        a1 += bits(face1 + off) * (kClip ? w[k] * keep[1][k] : w[k]);
+        a2 += bits(face2 + off) * (kClip ? w[k] * keep[2][k] : w[k]);
     }
-    return acc[0] * faces.weight[0] + acc[1] * faces.weight[1] + acc[2] * faces.weight[2];
+    return a0 * faces.weight[0] + a1 * faces.weight[1] + a2 * faces.weight[2];
 #endif
 }
 

@@ -42,6 +42,36 @@ int same_as_earlier(const VoxelInput& in, int f) {
     return -1;
 }
 
+// For each face with opacity, the face whose surface it shares (itself when first); -1
+// for faces without opacity. distinct_faces: faces with the same normal and position
+// (one flat surface seen from several sides). sides: faces whose normals lie within ~45°
+// of the first face of a side — P3 gathers the bounce once per voxel over its mean
+// normal; a thin wall's two sides (opposite normals) stay two.
+std::array<int, kFaceCount> distinct_faces(const VoxelInput& in) {
+    std::array<int, kFaceCount> of;
+    for (int f = 0; f < kFaceCount; ++f) {
+        const int g = same_as_earlier(in, f);
+        of[size_t(f)] = in[size_t(f)].opacity > 0 ? (g >= 0 ? g : f) : -1;
+    }
+    return of;
+}
+
+std::array<int, kFaceCount> sides(const VoxelInput& in) {
+    constexpr float kSameSide = 0.7f;  // cos 45.6°
+    std::array<int, kFaceCount> of;
+    of.fill(-1);
+    for (int f = 0; f < kFaceCount; ++f) {
+        if (!(in[size_t(f)].opacity > 0)) continue;
+        of[size_t(f)] = f;
+        for (int g = 0; g < f; ++g)
+            if (of[size_t(g)] == g && glm::dot(in[size_t(g)].normal, in[size_t(f)].normal) >= kSameSide) {
+                of[size_t(f)] = g;
+                break;
+            }
+    }
+    return of;
+}
+
 struct Shading {
     const RayTracer& tracer;
     const DirectLighting& lighting;
@@ -86,26 +116,40 @@ struct Shading {
         options.blend_levels = settings.blend_levels;
         options.bounds = bounds;
         if (settings.max_distance > 0) options.max_distance = settings.max_distance;
+        // The surfaces the cones gather for: one per face, or one per side of the voxel.
+        const std::array<int, kFaceCount> surface_of = settings.bounce_per_face ? distinct_faces(in) : sides(in);
+        std::array<Vec3, kFaceCount> normal{}, position{};
+        std::array<float, kFaceCount> weight{};
+        for (int f = 0; f < kFaceCount; ++f) {
+            const int g = surface_of[size_t(f)];
+            if (g < 0) continue;
+            const FaceInput& fi = in[size_t(f)];
+            normal[size_t(g)] += fi.opacity * fi.normal;
+            position[size_t(g)] += fi.opacity * fi.position;
+            weight[size_t(g)] += fi.opacity;
+        }
+        for (int g = 0; g < kFaceCount; ++g) {
+            if (!(weight[size_t(g)] > 0)) continue;
+            const float n_length = glm::length(normal[size_t(g)]);
+            const Vec3 n = n_length > 0 ? normal[size_t(g)] / n_length : in[size_t(g)].normal;
+            const Vec3 x = position[size_t(g)] / weight[size_t(g)];
+            E[g] = Vec3(0);
+            const Frame frame(n);
+            ConeOptions o = options;
+            o.clip = settings.clip_plane;
+            o.clip_plane = Vec4(n, glm::dot(n, x));
+            for (size_t c = 0; c < injection_set.directions.size(); ++c) {
+                Cone cone{x + settings.cone_offset * voxel * n, frame.to_world(injection_set.directions[c]),
+                          injection_set.tan_half_angle};
+                ConeResult r = trace_cone(view, cone, o);
+                E[g] += r.radiance * (injection_set.cosines[c] * injection_set.weights[c]);
+                cones += uint64_t(r.samples) << 32 | 1u;  // samples in the high half
+            }
+        }
         for (int f = 0; f < kFaceCount; ++f) {
             const FaceInput& fi = in[size_t(f)];
             if (!(fi.opacity > 0)) continue;
-            int g = same_as_earlier(in, f);
-            if (g >= 0) {
-                E[f] = E[g];
-            } else {
-                E[f] = Vec3(0);
-                const Frame frame(fi.normal);
-                ConeOptions o = options;
-                o.clip = settings.clip_plane;
-                o.clip_plane = Vec4(fi.normal, glm::dot(fi.normal, fi.position));
-                for (size_t c = 0; c < injection_set.directions.size(); ++c) {
-                    Cone cone{fi.position + settings.cone_offset * voxel * fi.normal,
-                              frame.to_world(injection_set.directions[c]), injection_set.tan_half_angle};
-                    ConeResult r = trace_cone(view, cone, o);
-                    E[f] += r.radiance * (injection_set.cosines[c] * injection_set.weights[c]);
-                    cones += uint64_t(r.samples) << 32 | 1u;  // samples in the high half
-                }
-            }
+            E[f] = E[surface_of[size_t(f)]];
             Vec3 L = Vec3(direct[size_t(f)]) / fi.opacity + fi.albedo * kInvPi * E[f];
             out[size_t(f)] = Vec4(L * fi.opacity, fi.opacity);
         }
@@ -183,6 +227,9 @@ const SettingsSchema& VctSettings::schema() {
             .quality_knob(1, 256);
         s.boolean("specular", d.specular).doc("One cone along the mirror direction, its aperture from the Phong exponent.");
         s.boolean("second_bounce", d.second_bounce).doc("Gather a bounce into the voxels before the final gather.");
+        s.boolean("bounce_per_face", d.bounce_per_face)
+            .doc("Gather the voxel bounce for every distinct face (true), or once per side of the voxel over its mean "
+                 "normal (false: P3 gathers once per voxel; a thin wall's two sides stay two).");
         s.integer("injection_cones", d.injection_cones).range(1, 256).unit("per voxel face")
             .doc("Cones gathering the second bounce.");
         s.number("ao_lambda", d.ao_lambda).at_least(0).doc("Eq. 4's ambient-occlusion fall-off per finest voxel of cone radius.");
@@ -221,6 +268,7 @@ VctSettings VctSettings::from(const Settings& s) {
     v.diffuse_cones = schema.get<int>(s, "diffuse_cones");
     v.specular = schema.get<bool>(s, "specular");
     v.second_bounce = schema.get<bool>(s, "second_bounce");
+    v.bounce_per_face = schema.get<bool>(s, "bounce_per_face");
     v.injection_cones = schema.get<int>(s, "injection_cones");
     v.ao_lambda = schema.get<float>(s, "ao_lambda");
     v.cone_step = schema.get<float>(s, "cone_step");

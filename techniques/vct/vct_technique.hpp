@@ -11,8 +11,9 @@
 //                dynamic scenes; with `update=strategy` it keeps its static voxels).
 //  2. injection— direct light into the V-buffer of every updated level (Embree shadow
 //                rays from each voxel face), anisotropic filtering finer → coarser, then
-//                the voxel bounce: 16 fixed cones per voxel face over the hemisphere of
-//                its mean normal gather the direct V-buffer; radiance = direct +
+//                the voxel bounce: 16 fixed cones per side of the voxel (its faces whose
+//                normals agree) over the hemisphere of its mean normal gather the direct
+//                V-buffer; radiance = direct +
 //                albedo/π·Σ; filtered again. Pixels then see two indirect bounces.
 //  3. shading  — primary visibility and direct lighting are ray traced by Embree (the
 //                paper rasterizes; we are on the CPU), then per pixel 16 diffuse cones
@@ -58,6 +59,7 @@ struct VctSettings {
     int diffuse_cones = 16;
     bool specular = true;
     bool second_bounce = true;
+    bool bounce_per_face = false;
     int injection_cones = 16;
     float ao_lambda = 0.1f;
     float cone_step = 0.25f;
