@@ -18,9 +18,9 @@ void CascadeConfig::validate() const {
         throw Error(where, "voxel size must be positive and finite, got " + std::to_string(voxel_size));
     if (!std::isfinite(anchor.x) || !std::isfinite(anchor.y) || !std::isfinite(anchor.z))
         throw Error(where, "anchor must be finite");
-    // Per cell: the G-buffer (52 bytes) and two RGBA16F radiance values.
+    // Per cell: the G-buffer (40 bytes) and two RGBA16F radiance values.
     double cells = double(levels) * double(resolution) * double(resolution) * double(resolution) * kFaceCount;
-    if (cells * 68.0 > double(size_t(8) << 30))
+    if (cells * 56.0 > double(size_t(8) << 30))
         throw Error(where, std::to_string(levels) + " levels of " + std::to_string(resolution) +
                                "³ would need more than 8 GiB");
 }
@@ -34,7 +34,6 @@ CascadedVoxelTexture::CascadedVoxelTexture(const CascadeConfig& config) : config
     opacity.assign(n, 0.0f);
     albedo.assign(n, Vec3(0));
     normal.assign(n, Vec3(0));
-    emission.assign(n, Vec3(0));
     position.assign(n, Vec3(0));
     direct.assign(n, HalfRGBA{});
     radiance.assign(n, HalfRGBA{});
@@ -97,7 +96,7 @@ void CascadedVoxelTexture::place(int level, const IVec3& origin) {
         for (size_t z = z0; z < z1; ++z) {
             const size_t first = index(0, level, UVec3(0, 0, uint32_t(z))), n = size_t(R) * size_t(R) * kFaceCount;
             std::fill_n(opacity.begin() + ptrdiff_t(first), n, 0.0f);
-            for (auto* a : {&albedo, &normal, &emission, &position}) std::fill_n(a->begin() + ptrdiff_t(first), n, Vec3(0));
+            for (auto* a : {&albedo, &normal, &position}) std::fill_n(a->begin() + ptrdiff_t(first), n, Vec3(0));
             for (auto* a : {&direct, &radiance}) std::fill_n(a->begin() + ptrdiff_t(first), n, HalfRGBA{});
         }
     });
@@ -140,7 +139,6 @@ void CascadedVoxelTexture::clear_gbuffer(int level, const VoxelBox& box) {
         std::fill_n(opacity.begin() + ptrdiff_t(i), n, 0.0f);
         std::fill_n(albedo.begin() + ptrdiff_t(i), n, Vec3(0));
         std::fill_n(normal.begin() + ptrdiff_t(i), n, Vec3(0));
-        std::fill_n(emission.begin() + ptrdiff_t(i), n, Vec3(0));
         std::fill_n(position.begin() + ptrdiff_t(i), n, Vec3(0));
     });
 }
@@ -212,7 +210,6 @@ void CascadedVoxelTexture::write(int level, const AnisotropicVoxel& voxel) {
         opacity[i] = d.opacity;
         albedo[i] = d.albedo;
         normal[i] = d.normal;
-        emission[i] = d.emission;
         position[i] = d.position;
     }
 }
@@ -227,7 +224,6 @@ AnisotropicVoxel CascadedVoxelTexture::read(int level, const IVec3& v) const {
         d.opacity = opacity[i];
         d.albedo = albedo[i];
         d.normal = normal[i];
-        d.emission = emission[i];
         d.position = position[i];
     }
     return voxel;
@@ -371,7 +367,7 @@ void CascadedVoxelTexture::refresh_occupancy(int level, const std::vector<HalfRG
 
 size_t CascadedVoxelTexture::gbuffer_bytes() const {
     return opacity.size() * sizeof(float) +
-           (albedo.size() + normal.size() + emission.size() + position.size()) * sizeof(Vec3);
+           (albedo.size() + normal.size() + position.size()) * sizeof(Vec3);
 }
 
 size_t CascadedVoxelTexture::radiance_bytes() const {

@@ -93,7 +93,7 @@ public:
     void clear_gbuffer(int level, const VoxelBox& box);         // box ∩ region
     void clear_radiance(int level, const VoxelBox& box);        // both radiance buffers
     void write(int level, const AnisotropicVoxel& voxel);       // must lie in the region
-    AnisotropicVoxel read(int level, const IVec3& v) const;     // G-buffer of one voxel
+    AnisotropicVoxel read(int level, const IVec3& v) const;     // G-buffer of one voxel (no emission)
     // Voxelizes box ∩ region of the level into the G-buffer (clearing it first).
     FragmentVoxelizeStats voxelize(int level, const FragmentVoxelizer& voxelizer, const VoxelBox& box);
     FragmentVoxelizeStats voxelize(int level, const FragmentVoxelizer& voxelizer) {
@@ -136,12 +136,13 @@ public:
     // What the paper's Tables 5/6 count: opacity only, one byte per voxel per face.
     size_t opacity_bytes_paper() const { return voxel_count() * size_t(kFaceCount); }
 
-    // Attributes, one allocation each. G-buffer: opacity, albedo, normal, emission,
-    // position. Radiance (V-buffer), premultiplied RGBA16F with alpha the opacity:
-    // `direct` (direct light only) and `radiance` (direct + voxel bounce), both
-    // anisotropically filtered from finer levels.
+    // Attributes, one allocation each. G-buffer: opacity, albedo, normal, position (what
+    // the light injection reads; emitters are lit by shadow rays, not injected, so the
+    // voxelizer's emission is not kept). Radiance (V-buffer), premultiplied RGBA16F with
+    // alpha the opacity: `direct` (direct light only) and `radiance` (direct + voxel
+    // bounce), both anisotropically filtered from finer levels.
     std::vector<float> opacity;
-    std::vector<Vec3> albedo, normal, emission, position;
+    std::vector<Vec3> albedo, normal, position;
     std::vector<HalfRGBA> direct, radiance;
 
 private:

@@ -251,7 +251,7 @@ std::vector<std::string> quick_notes(const SpecReduction& r, QuickNoteParts part
                           std::to_string(s.reference_spp) + ")");
     if (parts.cones) {
         const SettingsSchema& schema = TechniqueRegistry::builtin().find("vct")->settings_schema();
-        changes.push_back(std::to_string(kQuickInjectionCones) + " voxel-bounce cones per voxel face (full: " +
+        changes.push_back(std::to_string(kQuickInjectionCones) + " voxel-bounce cones per side of a voxel (full: " +
                           schema.spec("injection_cones").default_text() + ")");
     }
     if (changes.empty()) return {};

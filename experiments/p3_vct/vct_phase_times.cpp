@@ -141,7 +141,7 @@ void register_phase_times(ExperimentRegistry& registry) {
                   "primary = Embree primary rays (the paper rasterizes: ~1 ms on its GPU); update = voxel update "
                   "(dense: the whole grid re-voxelized every frame, as VXGI does for dynamic scenes — the paper's "
                   "15.5 ms; cascaded: scheduled scrolling and border voxelization — the paper's 2.0 ms); injection = "
-                  "direct light into the voxels + anisotropic filtering + the voxel bounce (16 cones per voxel face); "
+                  "direct light into the voxels + anisotropic filtering + the voxel bounce (16 cones per side of a voxel); "
                   "direct = ray-traced direct light at the pixels; diffuse = 16 cones per pixel; specular = one cone "
                   "per glossy pixel. As in the paper, the total leaves the update out: it is primary + injection + "
                   "direct + diffuse + specular at the fixed camera, median over frames. The update row is timed "

@@ -230,7 +230,7 @@ const SettingsSchema& VctSettings::schema() {
         s.boolean("bounce_per_face", d.bounce_per_face)
             .doc("Gather the voxel bounce for every distinct face (true), or once per side of the voxel over its mean "
                  "normal (false: P3 gathers once per voxel; a thin wall's two sides stay two).");
-        s.integer("injection_cones", d.injection_cones).range(1, 256).unit("per voxel face")
+        s.integer("injection_cones", d.injection_cones).range(1, 256).unit("per side of a voxel")
             .doc("Cones gathering the second bounce.");
         s.number("ao_lambda", d.ao_lambda).at_least(0).doc("Eq. 4's ambient-occlusion fall-off per finest voxel of cone radius.");
         s.number("cone_step", d.cone_step).above(0.01).at_most(4).unit("voxels of the sampled level")

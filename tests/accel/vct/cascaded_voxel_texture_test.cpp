@@ -197,7 +197,6 @@ void expect_same_level(const CascadedVoxelTexture& a, const CascadedVoxelTexture
                     ASSERT_EQ(a.opacity[i], b.opacity[j]) << "voxel " << x << "," << y << "," << z << " face " << f;
                     ASSERT_EQ(a.albedo[i], b.albedo[j]);
                     ASSERT_EQ(a.normal[i], b.normal[j]);
-                    ASSERT_EQ(a.emission[i], b.emission[j]);
                     ASSERT_EQ(a.position[i], b.position[j]);
                 }
                 occupied += a.occupied(level, v);

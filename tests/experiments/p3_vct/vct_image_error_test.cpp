@@ -31,6 +31,8 @@ constexpr ErrorBound kBounds[] = {
     {"sibenik", "dense", 0.06333418017134253, 0.2966222169561661},
 };
 
+void PrintTo(const ErrorBound& b, std::ostream* os) { *os << b.scene << ", " << b.structure; }
+
 class VctImageError : public ::testing::TestWithParam<ErrorBound> {};
 
 TEST_P(VctImageError, StaysWithinTwoPercentOfTheFloatImplementation) {
