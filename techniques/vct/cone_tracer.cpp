@@ -66,19 +66,6 @@ VoxelConeView VoxelConeView::dense(const DenseMipTexture& t, const std::vector<s
     return of_levels(Vec3(t.config().anchor), false, std::move(levels));
 }
 
-int VoxelConeView::level_containing(const Vec3& p, int from, float margin) const {
-    const int n = level_count();
-    if (n == 0) return -1;
-    from = std::clamp(from, 0, n - 1);
-    if (!nested_) return contains(levels_[0], p, margin) ? from : -1;
-    // If `from` holds p, the finest level holding p is `from` or a finer one: either way
-    // the answer is `from`.
-    if (contains(levels_[size_t(from)], p, margin)) return from;
-    for (int k = 0; k < n; ++k)
-        if (contains(levels_[size_t(k)], p, margin)) return std::max(k, from);
-    return -1;
-}
-
 namespace {
 
 // floor(x) as an int for |x| < 2^31, without a libm call.
@@ -173,8 +160,11 @@ Vec4 accumulate(const ConeLevel& l, const SampleCorners& c, const FaceWeights& f
 
 }  // namespace
 
-Vec4 VoxelConeView::sample_level(int level, const Vec3& p, const FaceWeights& faces, const Vec4* plane) const {
-    const ConeLevel& l = levels_[size_t(level)];
+namespace {
+
+// sample_level's work, inlined into the cone loop.
+[[gnu::always_inline]] inline Vec4 sample(const ConeLevel& l, const Vec3& anchor_, const Vec3& p,
+                                          const FaceWeights& faces, const Vec4* plane) {
     const SampleCorners c = corners_of(l, (p - anchor_) * l.inv_voxel_size);
     if (l.occupancy && !l.occupancy[c.occupancy]) return Vec4(0.0f);  // all eight texels empty
     if (!plane) return accumulate<false>(l, c, faces, nullptr);
@@ -203,6 +193,12 @@ Vec4 VoxelConeView::sample_level(int level, const Vec3& p, const FaceWeights& fa
         std::copy_n(front ? keep_front : keep_back, 8, keep[f]);
     }
     return accumulate<true>(l, c, faces, keep);
+}
+
+}  // namespace
+
+Vec4 VoxelConeView::sample_level(int level, const Vec3& p, const FaceWeights& faces, const Vec4* plane) const {
+    return sample(levels_[size_t(level)], anchor_, p, faces, plane);
 }
 
 ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOptions& options) {
@@ -241,10 +237,10 @@ ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOpt
         // a coarser level (then that level's voxel) or beyond the coarsest.
         const float voxel = l0 > lod ? view.level(l0).voxel_size : std::clamp(lod_width, w0, coarsest);
         const Vec4* clip = plane && glm::dot(Vec3(*plane), p) - plane->w <= plane_reach * voxel ? plane : nullptr;
-        Vec4 s = view.sample_level(l0, p, faces, clip);
+        Vec4 s = sample(view.level(l0), view.anchor(), p, faces, clip);
         if (options.blend_levels && l0 + 1 < n) {
             const float frac = std::log2(voxel / view.level(l0).voxel_size);
-            if (frac > 0.0f) s = glm::mix(s, view.sample_level(l0 + 1, p, faces, clip), frac);
+            if (frac > 0.0f) s = glm::mix(s, sample(view.level(l0 + 1), view.anchor(), p, faces, clip), frac);
         }
         const float step = voxel * options.step;  // the sampled level's voxel: never skips over it
         ++r.samples;

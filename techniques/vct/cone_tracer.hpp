@@ -22,6 +22,7 @@
 // cone leaving a surface could see that surface's own dark back side through the wide
 // trilinear footprint of a coarse level; the optional clip plane (the surface's tangent
 // plane) removes voxels behind it and the back-facing faces of voxels it cuts.
+#include <algorithm>
 #include <vector>
 #include "accel/vct/anisotropic_voxel.hpp"
 #include "accel/vct/cascaded_voxel_texture.hpp"
@@ -53,6 +54,7 @@ public:
 
     int level_count() const { return int(levels_.size()); }
     float base_voxel_size() const { return levels_.empty() ? 1.0f : levels_[0].voxel_size; }
+    const Vec3& anchor() const { return anchor_; }  // world position of voxel (0, 0, 0)'s corner
     const ConeLevel& level(int k) const { return levels_[size_t(k)]; }
     // Finest level whose region holds p at least `margin` voxels inside; -1 if none.
     int finest_level_containing(const Vec3& p, float margin = 1.0f) const {
@@ -75,6 +77,19 @@ private:
     bool nested_ = true;            // cascades: each level has its own region; mips share one
     std::vector<ConeLevel> levels_;
 };
+
+inline int VoxelConeView::level_containing(const Vec3& p, int from, float margin) const {
+    const int n = level_count();
+    if (n == 0) return -1;
+    from = std::clamp(from, 0, n - 1);
+    if (!nested_) return contains(levels_[0], p, margin) ? from : -1;
+    // If `from` holds p, the finest level holding p is `from` or a finer one: either way
+    // the answer is `from`.
+    if (contains(levels_[size_t(from)], p, margin)) return from;
+    for (int k = 0; k < n; ++k)
+        if (contains(levels_[size_t(k)], p, margin)) return std::max(k, from);
+    return -1;
+}
 
 struct Cone {
     Vec3 origin{0};
