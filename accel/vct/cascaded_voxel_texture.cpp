@@ -18,9 +18,9 @@ void CascadeConfig::validate() const {
         throw Error(where, "voxel size must be positive and finite, got " + std::to_string(voxel_size));
     if (!std::isfinite(anchor.x) || !std::isfinite(anchor.y) || !std::isfinite(anchor.z))
         throw Error(where, "anchor must be finite");
-    // Per cell: the G-buffer (40 bytes) and two RGBA16F radiance values.
+    // Per cell: the G-buffer (20 bytes) and two RGBA16F radiance values.
     double cells = double(levels) * double(resolution) * double(resolution) * double(resolution) * kFaceCount;
-    if (cells * 56.0 > double(size_t(8) << 30))
+    if (cells * 36.0 > double(size_t(8) << 30))
         throw Error(where, std::to_string(levels) + " levels of " + std::to_string(resolution) +
                                "³ would need more than 8 GiB");
 }
@@ -32,9 +32,7 @@ CascadedVoxelTexture::CascadedVoxelTexture(const CascadeConfig& config) : config
     gbuffer_clear_.assign(size_t(config_.levels), 1);
     const size_t n = cell_count();
     opacity.assign(n, 0.0f);
-    albedo.assign(n, Vec3(0));
-    normal.assign(n, Vec3(0));
-    position.assign(n, Vec3(0));
+    surface.assign(n, PackedSurface{});
     direct.assign(n, HalfRGBA{});
     radiance.assign(n, HalfRGBA{});
     occupancy_.assign(size_t(config_.levels) * texels_per_level(), 1);
@@ -96,7 +94,7 @@ void CascadedVoxelTexture::place(int level, const IVec3& origin) {
         for (size_t z = z0; z < z1; ++z) {
             const size_t first = index(0, level, UVec3(0, 0, uint32_t(z))), n = size_t(R) * size_t(R) * kFaceCount;
             std::fill_n(opacity.begin() + ptrdiff_t(first), n, 0.0f);
-            for (auto* a : {&albedo, &normal, &position}) std::fill_n(a->begin() + ptrdiff_t(first), n, Vec3(0));
+            std::fill_n(surface.begin() + ptrdiff_t(first), n, PackedSurface{});
             for (auto* a : {&direct, &radiance}) std::fill_n(a->begin() + ptrdiff_t(first), n, HalfRGBA{});
         }
     });
@@ -137,9 +135,7 @@ void CascadedVoxelTexture::clear_gbuffer(int level, const VoxelBox& box) {
     if (gbuffer_clear_[size_t(level)]) return;  // nothing written since the level was cleared
     for_each_run(level, box, [&](size_t i, size_t n) {
         std::fill_n(opacity.begin() + ptrdiff_t(i), n, 0.0f);
-        std::fill_n(albedo.begin() + ptrdiff_t(i), n, Vec3(0));
-        std::fill_n(normal.begin() + ptrdiff_t(i), n, Vec3(0));
-        std::fill_n(position.begin() + ptrdiff_t(i), n, Vec3(0));
+        std::fill_n(surface.begin() + ptrdiff_t(i), n, PackedSurface{});
     });
 }
 
@@ -204,29 +200,14 @@ void CascadedVoxelTexture::write(int level, const AnisotropicVoxel& voxel) {
     gbuffer_clear_[size_t(level)] = false;
     if (!contains(level, voxel.coord))
         throw Error("cascaded voxel texture", "voxel outside level " + std::to_string(level) + "'s region");
+    const Vec3 center = gilab::voxel_center(lattice(level), voxel.coord);
+    const float size = float(voxel_size(level));
+    const size_t first = index_of_voxel(0, level, voxel.coord);
     for (int f = 0; f < kFaceCount; ++f) {
         const VoxelFaceData& d = voxel.faces[size_t(f)];
-        size_t i = index_of_voxel(f, level, voxel.coord);
-        opacity[i] = d.opacity;
-        albedo[i] = d.albedo;
-        normal[i] = d.normal;
-        position[i] = d.position;
+        opacity[first + size_t(f)] = d.opacity;
+        surface[first + size_t(f)] = pack_surface(d, center, size);
     }
-}
-
-AnisotropicVoxel CascadedVoxelTexture::read(int level, const IVec3& v) const {
-    AnisotropicVoxel voxel;
-    voxel.coord = v;
-    if (!contains(level, v)) return voxel;
-    for (int f = 0; f < kFaceCount; ++f) {
-        size_t i = index_of_voxel(f, level, v);
-        VoxelFaceData& d = voxel.faces[size_t(f)];
-        d.opacity = opacity[i];
-        d.albedo = albedo[i];
-        d.normal = normal[i];
-        d.position = position[i];
-    }
-    return voxel;
 }
 
 FragmentVoxelizeStats CascadedVoxelTexture::voxelize(int level, const FragmentVoxelizer& voxelizer,
@@ -367,7 +348,7 @@ void CascadedVoxelTexture::refresh_occupancy(int level, const std::vector<HalfRG
 
 size_t CascadedVoxelTexture::gbuffer_bytes() const {
     return opacity.size() * sizeof(float) +
-           (albedo.size() + normal.size() + position.size()) * sizeof(Vec3);
+           surface.size() * sizeof(PackedSurface);
 }
 
 size_t CascadedVoxelTexture::radiance_bytes() const {

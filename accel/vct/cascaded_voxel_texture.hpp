@@ -21,6 +21,7 @@
 #include "accel/vct/anisotropic_voxel.hpp"
 #include "accel/vct/fragment_voxelizer.hpp"
 #include "accel/vct/half_rgba.hpp"
+#include "accel/vct/packed_surface.hpp"
 #include "core/util/math.hpp"
 
 namespace gilab {
@@ -93,7 +94,6 @@ public:
     void clear_gbuffer(int level, const VoxelBox& box);         // box ∩ region
     void clear_radiance(int level, const VoxelBox& box);        // both radiance buffers
     void write(int level, const AnisotropicVoxel& voxel);       // must lie in the region
-    AnisotropicVoxel read(int level, const IVec3& v) const;     // G-buffer of one voxel (no emission)
     // Voxelizes box ∩ region of the level into the G-buffer (clearing it first).
     FragmentVoxelizeStats voxelize(int level, const FragmentVoxelizer& voxelizer, const VoxelBox& box);
     FragmentVoxelizeStats voxelize(int level, const FragmentVoxelizer& voxelizer) {
@@ -136,13 +136,14 @@ public:
     // What the paper's Tables 5/6 count: opacity only, one byte per voxel per face.
     size_t opacity_bytes_paper() const { return voxel_count() * size_t(kFaceCount); }
 
-    // Attributes, one allocation each. G-buffer: opacity, albedo, normal, position (what
-    // the light injection reads; emitters are lit by shadow rays, not injected, so the
-    // voxelizer's emission is not kept). Radiance (V-buffer), premultiplied RGBA16F with
+    // Attributes, one allocation each. G-buffer: opacity and the packed surface (albedo,
+    // normal, position: accel/vct/packed_surface.hpp) — what the light injection reads;
+    // emitters are lit by shadow rays, not injected, so the voxelizer's emission is not
+    // kept. Radiance (V-buffer), premultiplied RGBA16F with
     // alpha the opacity: `direct` (direct light only) and `radiance` (direct + voxel
     // bounce), both anisotropically filtered from finer levels.
     std::vector<float> opacity;
-    std::vector<Vec3> albedo, normal, position;
+    std::vector<PackedSurface> surface;
     std::vector<HalfRGBA> direct, radiance;
 
 private:

@@ -50,7 +50,11 @@ DenseMipTexture::DenseMipTexture(const DenseMipConfig& config) : config_(config)
 
 FragmentVoxelizeStats DenseMipTexture::voxelize(const FragmentVoxelizer& voxelizer) {
     FragmentVoxelizeStats stats;
-    voxels = voxelizer.voxelize(lattice(), region(), &stats);
+    const std::vector<AnisotropicVoxel> full = voxelizer.voxelize(lattice(), region(), &stats);
+    voxels.clear();
+    voxels.shrink_to_fit();
+    voxels.reserve(full.size());
+    for (const AnisotropicVoxel& v : full) voxels.push_back(pack_voxel(v, lattice()));
     return stats;
 }
 

@@ -7,13 +7,15 @@
 // buffer is one allocation of RGBA16F texels laid out [z][y][x][face], as the cascades'
 // levels (accel/vct/cascaded_voxel_texture.hpp), and has the same occupancy map.
 //
-// The G-buffer stays sparse (the occupied voxels as a list): a dense G-buffer of five
-// attributes × six faces would not fit at the sizes the baseline runs at.
+// The G-buffer stays sparse (the occupied voxels as a list, each face packed as the
+// cascades pack theirs, accel/vct/packed_surface.hpp): a dense G-buffer of six faces per
+// cell would not fit at the sizes the baseline runs at.
 #include <cstdint>
 #include <vector>
 #include "accel/vct/anisotropic_voxel.hpp"
 #include "accel/vct/fragment_voxelizer.hpp"
 #include "accel/vct/half_rgba.hpp"
+#include "accel/vct/packed_surface.hpp"
 #include "core/util/math.hpp"
 
 namespace gilab {
@@ -60,10 +62,10 @@ public:
 
     size_t voxel_count() const { return size_t(config_.resolution) * config_.resolution * config_.resolution; }
     size_t radiance_bytes() const;  // both radiance buffers and the occupancy maps
-    size_t gbuffer_bytes() const { return voxels.capacity() * sizeof(AnisotropicVoxel); }
+    size_t gbuffer_bytes() const { return voxels.capacity() * sizeof(PackedVoxel); }
     size_t bytes() const { return radiance_bytes() + gbuffer_bytes(); }
 
-    std::vector<AnisotropicVoxel> voxels;       // sparse G-buffer, (z, y, x) order
+    std::vector<PackedVoxel> voxels;            // sparse G-buffer, (z, y, x) order
     std::vector<std::vector<HalfRGBA>> direct;      // per level, premultiplied RGBA16F
     std::vector<std::vector<HalfRGBA>> radiance;    // per level, direct + voxel bounce
 

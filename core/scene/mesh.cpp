@@ -14,7 +14,11 @@ Bounds3 Mesh::bounds() const {
 namespace {
 
 std::string format_vec(const Vec3& v) {
-    return "(" + number_as_given(v.x) + ", " + number_as_given(v.y) + ", " + number_as_given(v.z) + ")";
+    // Appended piece by piece: GCC 12 warns (-Wrestrict) on "(" + std::string.
+    std::string text = "(";
+    text += join(std::initializer_list<std::string>{number_as_given(v.x), number_as_given(v.y), number_as_given(v.z)});
+    text += ")";
+    return text;
 }
 
 std::string mesh_label(const Mesh& mesh) {

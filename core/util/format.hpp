@@ -3,8 +3,22 @@
 #include <charconv>
 #include <sstream>
 #include <string>
+#include <string_view>
 
 namespace gilab {
+
+// The values with `separator` between them: join({"a", "b"}) is "a, b".
+template <class Range>
+std::string join(const Range& values, std::string_view separator = ", ") {
+    std::string out;
+    bool first = true;
+    for (const auto& v : values) {
+        if (!first) out += separator;
+        out += v;
+        first = false;
+    }
+    return out;
+}
 
 // 9 significant digits, enough to round-trip a float and short for round values
 // ("0.05", not "0.0500000007"); for computed values in headers and reports.

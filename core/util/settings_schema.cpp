@@ -81,9 +81,7 @@ std::string requirement_text(const SettingSpec& s) {
 
 // "cascaded, dense": the choices as a message lists them.
 std::string choice_list(const SettingSpec& s) {
-    std::string out;
-    for (const std::string& c : s.choices) out += (out.empty() ? "" : ", ") + c;
-    return out;
+    return join(s.choices);
 }
 
 // "≥ 1 (pixels)", "(degrees)", "≥ 1".

@@ -4,6 +4,7 @@
 #include <map>
 #include "core/image/image_io.hpp"
 #include "core/util/error.hpp"
+#include "core/util/format.hpp"
 #include "core/util/settings.hpp"
 #include "scenes/builtin_scenes.hpp"
 #include "scenes/scene_library.hpp"
@@ -215,12 +216,6 @@ std::vector<std::pair<std::string, std::vector<std::string>>> axis_values(const 
     return out;
 }
 
-std::string listed(const std::vector<std::string>& values) {
-    std::string out;
-    for (const std::string& v : values) out += (out.empty() ? "" : ", ") + v;
-    return out;
-}
-
 }  // namespace
 
 std::vector<std::string> quick_notes(const SpecReduction& r, QuickNoteParts parts) {
@@ -233,8 +228,8 @@ std::vector<std::string> quick_notes(const SpecReduction& r, QuickNoteParts part
         for (const auto& [key, values] : quick) {
             auto f = std::find_if(full.begin(), full.end(), [&](const auto& kv) { return kv.first == key; });
             if (f != full.end() && f->second == values) continue;
-            std::string change = key + " " + listed(values);
-            if (f != full.end()) change += " (full: " + listed(f->second) + ")";
+            std::string change = key + " " + join(values);
+            if (f != full.end()) change += " (full: " + join(f->second) + ")";
             if (key == "dense_resolution") {
                 change += " where the variant does not fix its own";
                 dense_smaller = true;
@@ -255,7 +250,7 @@ std::vector<std::string> quick_notes(const SpecReduction& r, QuickNoteParts part
                           schema.spec("injection_cones").default_text() + ")");
     }
     if (changes.empty()) return {};
-    std::string note = "Quick run: " + listed(changes) + ".";
+    std::string note = "Quick run: " + join(changes) + ".";
     if (dense_smaller) note += " At this size the dense texture is small, so memory and time ratios favour it.";
     return {note};
 }

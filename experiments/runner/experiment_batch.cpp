@@ -10,6 +10,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include "core/util/error.hpp"
+#include "core/util/format.hpp"
 #include "core/util/parallel.hpp"
 #include "experiments/runner/result_writers.hpp"
 
@@ -69,9 +70,7 @@ private:
 };
 
 std::string list_names(const std::vector<std::string>& names) {
-    std::string s;
-    for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
-    return s.empty() ? "none" : s;
+    return names.empty() ? "none" : join(names);
 }
 
 std::string describe_interruption(const ExperimentBatch& batch, const std::vector<std::string>& kept,

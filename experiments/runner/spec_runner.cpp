@@ -10,6 +10,7 @@
 #include <thread>
 #include "core/image/image_io.hpp"
 #include "core/image/image_metrics.hpp"
+#include "core/util/format.hpp"
 #include "core/util/error.hpp"
 #include "core/util/stats.hpp"
 #include "experiments/runner/interleaved_render.hpp"
@@ -251,12 +252,6 @@ nlohmann::json run_planned_task(const ExperimentSpec& spec, const SpecTask& task
     return result;
 }
 
-std::string joined(const std::set<std::string>& values) {
-    std::string out;
-    for (const auto& v : values) out += (out.empty() ? "" : ", ") + v;
-    return out;
-}
-
 }  // namespace
 
 ResultTable SpecReduction::default_table() const {
@@ -439,8 +434,8 @@ ExperimentOutput merge_spec_tasks(const ExperimentSpec& spec, const ExperimentCo
     }
     out.notes.push_back("Merged from " + std::to_string(tasks.size() - missing.size()) + " task files (" +
                         spec_task_file(ctx.output_dir, 0, ctx.quick).parent_path().filename().string() +
-                        " plan) measured at revision " + joined(revisions) + " with " + joined(threads) +
-                        " threads on " + joined(machines) + "; the header above names the merging run.");
+                        " plan) measured at revision " + join(revisions) + " with " + join(threads) +
+                        " threads on " + join(machines) + "; the header above names the merging run.");
     if (revisions.size() > 1 || threads.size() > 1 || machines.size() > 1)
         out.notes.push_back("Tasks ran at more than one revision, thread count or machine: times are comparable only "
                             "within one.");

@@ -2,6 +2,7 @@
 
 #include <map>
 #include "core/util/error.hpp"
+#include "core/util/format.hpp"
 
 namespace gilab {
 
@@ -145,8 +146,7 @@ int show_status(const Sweep& sweep, std::ostream& out) {
     out << std::endl;
     if (sweep.on == "slurm") {
         if (!slurm.queued_jobs.empty()) {
-            std::string jobs;
-            for (const std::string& j : slurm.queued_jobs) jobs += (jobs.empty() ? "" : ",") + j;
+            const std::string jobs = join(slurm.queued_jobs, ",");
             out << "queued or running: jobs " << jobs << " (squeue -j " << jobs << ")" << std::endl;
         }
         if (!slurm.squeue_available) out << "squeue is not available here: Slurm's view of the tasks is not shown" << std::endl;
@@ -169,8 +169,7 @@ int resume(Sweep sweep, const SweepCommand& c, std::ostream& out, std::ostream& 
     }
     const SlurmTaskStates states = query_slurm_states(sweep);
     if (!states.queued_jobs.empty()) {
-        std::string jobs;
-        for (const std::string& j : states.queued_jobs) jobs += (jobs.empty() ? "" : ",") + j;
+        const std::string jobs = join(states.queued_jobs, ",");
         throw Error("sweep resume", "jobs " + jobs + " of this sweep are still queued or running; resuming now would "
                                     "run their tasks twice. Wait for them (squeue -j " + jobs +
                                     ") or cancel them (scancel " + jobs + ") first");

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 #include "core/util/error.hpp"
+#include "core/util/format.hpp"
 #include "core/util/parallel.hpp"
 
 extern char** environ;
@@ -101,12 +102,6 @@ std::vector<std::string> run_all(const Sweep& sweep, const std::vector<SweepProc
     return failed;
 }
 
-std::string listed(const std::vector<std::string>& labels) {
-    std::string list;
-    for (const std::string& l : labels) list += (list.empty() ? "" : ", ") + l;
-    return list;
-}
-
 }  // namespace
 
 int run_sweep_locally(const Sweep& sweep, const LocalSweepOptions& options, std::ostream& out, std::ostream& err) {
@@ -138,7 +133,7 @@ int run_sweep_locally(const Sweep& sweep, const LocalSweepOptions& options, std:
         const std::vector<std::string> failed = run_all(sweep, references, reference_jobs, reference_threads,
                                                         [](const SweepProcess&) { return true; }, out);
         if (!failed.empty())
-            err << "gilab: sweep: rendering references failed for " << listed(failed)
+            err << "gilab: sweep: rendering references failed for " << join(failed)
                 << "; the tasks that need them try again themselves" << std::endl;
     }
 
@@ -151,7 +146,7 @@ int run_sweep_locally(const Sweep& sweep, const LocalSweepOptions& options, std:
         sweep, tasks, jobs, threads, [&sweep](const SweepProcess& p) { return task_done(sweep, p.task); }, out);
     const int merge_failures = merge_sweep(sweep, out, err);
     if (!failed.empty())
-        err << "gilab: sweep: " << failed.size() << " task(s) failed: " << listed(failed)
+        err << "gilab: sweep: " << failed.size() << " task(s) failed: " << join(failed)
             << "; their cells are missing from the tables. Run the same command again (or `gilab sweep resume "
             << sweep.directory().string() << "`) to run only the tasks without a result." << std::endl;
     return failed.empty() && merge_failures == 0 ? 0 : 1;

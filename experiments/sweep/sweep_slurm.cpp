@@ -8,6 +8,7 @@
 #include <sstream>
 #include "core/image/image_io.hpp"
 #include "core/util/error.hpp"
+#include "core/util/format.hpp"
 #include "experiments/sweep/program_call.hpp"
 #include "experiments/sweep/task_costs.hpp"
 
@@ -65,8 +66,7 @@ std::string submit(const std::vector<std::string>& args) {
     std::string id = r.output.substr(0, r.output.find_first_of(";\n"));
     const bool numeric = !id.empty() && id.find_first_not_of("0123456789") == std::string::npos;
     if (r.exit_code != 0 || !numeric) {
-        std::string command;
-        for (const std::string& a : args) command += (command.empty() ? "" : " ") + a;
+        const std::string command = join(args, " ");
         throw Error("sbatch", "`" + command + "` failed (exit code " + std::to_string(r.exit_code) + "): " + r.output);
     }
     return id;
@@ -189,8 +189,7 @@ std::string default_time_limit(const Sweep& sweep, const std::vector<SweepTask>&
         else unmeasured.insert(t.experiment);
     }
     if (!unmeasured.empty() || !sweep.axes.empty()) {
-        std::string names;
-        for (const std::string& n : unmeasured) names += (names.empty() ? "" : ", ") + n;
+        const std::string names = join(unmeasured);
         why = !sweep.axes.empty() ? "no --time: extra axes change the tasks' cost, so the cluster's default limit applies"
                                   : "no --time: the cluster's default limit applies (no measured task time for " + names +
                                         " in experiments/sweep/task_costs.json)";
@@ -323,11 +322,12 @@ std::map<std::string, std::string> parse_states(const std::string& output) {
 
 SlurmTaskStates query_slurm_states(const Sweep& sweep) {
     SlurmTaskStates result;
-    std::string jobs;
+    std::vector<std::string> job_ids;
     for (const nlohmann::json& s : sweep.submissions)
         for (const char* key : {"references_job", "array_job", "merge_job"})
-            if (!s.value(key, std::string()).empty()) jobs += (jobs.empty() ? "" : ",") + s.value(key, std::string());
-    if (jobs.empty()) return result;
+            if (!s.value(key, std::string()).empty()) job_ids.push_back(s.value(key, std::string()));
+    if (job_ids.empty()) return result;
+    const std::string jobs = join(job_ids, ",");
     std::map<std::string, std::string> queued, accounted;
     if (program_on_path("squeue")) {
         const ProgramResult r = call_program({"squeue", "-h", "-r", "-j", jobs, "-o", "%i|%T"});

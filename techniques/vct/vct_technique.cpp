@@ -157,21 +157,26 @@ struct Shading {
     }
 };
 
+FaceInput face_input(float opacity, const PackedSurface& s, const Vec3& center, float voxel_size) {
+    if (!(opacity > 0)) return {};
+    return {opacity, unpack_albedo(s), unpack_normal(s), unpack_position(s, center, voxel_size)};
+}
+
 VoxelInput input_of(const CascadedVoxelTexture& t, int level, const IVec3& v) {
     VoxelInput in;
-    for (int f = 0; f < kFaceCount; ++f) {
-        size_t i = t.index_of_voxel(f, level, v);
-        in[size_t(f)] = {t.opacity[i], t.albedo[i], t.normal[i], t.position[i]};
-    }
+    const Vec3 center = voxel_center(t.lattice(level), v);
+    const float size = float(t.voxel_size(level));
+    const size_t first = t.index_of_voxel(0, level, v);
+    for (int f = 0; f < kFaceCount; ++f)
+        in[size_t(f)] = face_input(t.opacity[first + size_t(f)], t.surface[first + size_t(f)], center, size);
     return in;
 }
 
-VoxelInput input_of(const AnisotropicVoxel& voxel) {
+VoxelInput input_of(const PackedVoxel& voxel, const VoxelLattice& lattice) {
     VoxelInput in;
-    for (int f = 0; f < kFaceCount; ++f) {
-        const VoxelFaceData& d = voxel.faces[size_t(f)];
-        in[size_t(f)] = {d.opacity, d.albedo, d.normal, d.position};
-    }
+    const Vec3 center = voxel_center(lattice, voxel.coord);
+    for (int f = 0; f < kFaceCount; ++f)
+        in[size_t(f)] = face_input(voxel.opacity[size_t(f)], voxel.surface[size_t(f)], center, float(lattice.voxel_size));
     return in;
 }
 
@@ -490,7 +495,7 @@ void VctTechnique::light_dense() {
     parallel_for(list.size(), 16, [&](size_t b, size_t e) {
         uint64_t local = 0;
         for (size_t i = b; i < e; ++i) {
-            values[i] = shading.direct(input_of(list[i]), 0, list[i].coord, voxel, local);
+            values[i] = shading.direct(input_of(list[i], t.lattice()), 0, list[i].coord, voxel, local);
             const size_t first = t.index(0, 0, list[i].coord);
             for (int f = 0; f < kFaceCount; ++f) t.direct[0][first + size_t(f)] = to_half_rgba(values[i][size_t(f)]);
         }
@@ -508,8 +513,9 @@ void VctTechnique::light_dense() {
     parallel_for(list.size(), 4, [&](size_t b, size_t e) {
         uint64_t local = 0;
         for (size_t i = b; i < e; ++i) {
-            const VoxelRadiance r =
-                settings_.second_bounce ? shading.bounce(input_of(list[i]), values[i], view, voxel, local) : values[i];
+            const VoxelRadiance r = settings_.second_bounce
+                                        ? shading.bounce(input_of(list[i], t.lattice()), values[i], view, voxel, local)
+                                        : values[i];
             const size_t first = t.index(0, 0, list[i].coord);
             for (int f = 0; f < kFaceCount; ++f) t.radiance[0][first + size_t(f)] = to_half_rgba(r[size_t(f)]);
         }
