@@ -14,7 +14,9 @@
 //                the voxel bounce: 16 fixed cones per side of the voxel (its faces whose
 //                normals agree) over the hemisphere of its mean normal gather the direct
 //                V-buffer; radiance = direct +
-//                albedo/π·Σ; filtered again. Pixels then see two indirect bounces.
+//                albedo/π·Σ; filtered again. Pixels then see two indirect bounces
+//                (temporal_bounces: the voxel bounce gathers the frames before's
+//                radiance instead, one bounce more every frame).
 //  3. shading  — primary visibility and direct lighting are ray traced by Embree (the
 //                paper rasterizes; we are on the CPU), then per pixel 16 diffuse cones
 //                (indirect diffuse + ambient occlusion) and one specular cone along the
@@ -60,6 +62,7 @@ struct VctSettings {
     bool specular = true;
     bool second_bounce = true;
     bool bounce_per_face = false;
+    bool temporal_bounces = false;
     int injection_cones = 16;
     float ao_lambda = 0.1f;
     float cone_step = 0.25f;

@@ -343,11 +343,12 @@ TEST(VctTechnique, StereoLayersAndProvenance) {
 
 TEST(VctTechnique, SameImagesAtOneAndTwoThreads) {
     Scene scene = make_cornell_box();
-    for (const char* structure : {"cascaded", "dense"}) {
+    for (const char* structure : {"cascaded", "dense"})
+    for (const bool temporal : {false, true}) {
         auto run = [&](int threads) {
             ThreadLimit limit(threads);
             auto t = prepared(scene, {{"dense_resolution", 32}, {"structure", structure}, {"levels", 4}, {"resolution", 16},
-                                      {"injection_cones", 4}, {"diffuse_cones", 8}});
+                                      {"injection_cones", 4}, {"diffuse_cones", 8}, {"temporal_bounces", temporal}});
             std::vector<Film> out;
             for (int i = 0; i < 2; ++i) {  // two frames: the second one scrolls
                 Vec3 eye(0.4f + 0.1f * float(i), 0.45f, 0.1f);
@@ -359,7 +360,25 @@ TEST(VctTechnique, SameImagesAtOneAndTwoThreads) {
         for (size_t f = 0; f < one.size(); ++f)
             for (const auto& [name, layer] : one[f].layers())
                 ASSERT_EQ(std::memcmp(layer.data.data(), two[f].layer(name).data.data(), layer.data.size() * sizeof(float)), 0)
-                    << structure << " frame " << f << " layer " << name;
+                    << structure << (temporal ? " temporal" : "") << " frame " << f << " layer " << name;
+    }
+}
+
+// Temporal bounces: each frame's voxel bounce gathers the radiance of the frames before.
+// The first frame after prepare sees P3's two bounces (prepare lit the voxels with direct
+// light only); every later frame adds one: more indirect light each frame.
+TEST(VctTechnique, TemporalBouncesAddABounceEachFrame) {
+    Scene scene = make_cornell_box();
+    const EyeCamera camera = inside_camera(24);
+    auto two = prepared(scene, {{"dense_resolution", 32}, {"structure", "dense"}});
+    auto many = prepared(scene, {{"dense_resolution", 32}, {"structure", "dense"}, {"temporal_bounces", true}});
+    double previous = 0;
+    for (int frame = 0; frame < 3; ++frame) {
+        const double fixed = mean_value(render_one(*two, camera), "indirect");
+        const double growing = mean_value(render_one(*many, camera), "indirect");
+        if (frame == 0) EXPECT_NEAR(growing, fixed, 1e-6 * fixed);
+        else EXPECT_GT(growing, previous * 1.02) << "frame " << frame;
+        previous = growing;
     }
 }
 
