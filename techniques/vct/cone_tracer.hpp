@@ -6,11 +6,13 @@
 // width matches the footprint — we read it as lod = log2(d / w₀), i.e. voxel width
 // w₀·2^lod = d — and the sample is further pushed to the finest level whose region
 // contains it (far from the viewer only coarse cascades exist). The level is addressed
-// directly (no tree walk); samples are trilinear within one level and one face block:
-// the position is clamped to the centres of the level's border voxels, so a sample never
-// blends across a level/face border or wraps around the toroidal storage (optionally,
-// fractional levels blend the two nearest levels). The three faces turned towards the
-// apex are blended by the squared direction components. Samples are composited front to
+// directly (no tree walk); samples are trilinear within one level: the position is
+// clamped to the centres of the level's border voxels, so a sample never blends across a
+// level border or wraps around the toroidal storage (optionally, fractional levels blend
+// the two nearest levels). The three faces turned towards the apex are blended by the
+// squared direction components; a sample whose eight texels the level's occupancy map
+// marks empty reads nothing. Texels are RGBA16F (accel/vct/half_rgba.hpp), weighted in
+// SSE2 four channels at a time. Samples are composited front to
 // back (eq. 3 on premultiplied colour: c += (1 − α)·c₂, α += (1 − α)·α₂; the paper's
 // "c = αc + …" as printed would scale earlier samples down and lose energy); the step is
 // a fraction of the sampled level's voxel, and optionally the opacity is corrected for
