@@ -1,8 +1,9 @@
-// Cascaded voxel texture and its fragment voxelizer: Fig. 2 layout, toroidal
-// addressing round trips (also after scrolling), nested snapped placement, per-face
-// opacities of walls, one-sided emission, scroll + re-voxelize = voxelize from scratch,
-// scroll filling from the coarser level, the anisotropic 2×2×2 filter, the dense mip
-// chain, thread-count independence and input errors.
+// Cascaded voxel texture and its fragment voxelizer: the cell layout (a block per level,
+// a voxel's six faces together), toroidal addressing round trips (also after scrolling),
+// nested snapped placement, per-face opacities of walls, one-sided emission, scroll +
+// re-voxelize = voxelize from scratch, scroll filling from the coarser level, the
+// anisotropic 2×2×2 filter, the dense mip chain, thread-count independence and input
+// errors.
 #include <gtest/gtest.h>
 
 #include <cstring>
