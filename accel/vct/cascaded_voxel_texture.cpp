@@ -4,6 +4,7 @@
 #include <bit>
 #include <cmath>
 #include <string>
+#include "accel/vct/occupancy_map.hpp"
 #include "core/util/error.hpp"
 #include "core/util/parallel.hpp"
 
@@ -323,27 +324,8 @@ void CascadedVoxelTexture::downsample(int level, std::vector<HalfRGBA>& buffer) 
 }
 
 void CascadedVoxelTexture::refresh_occupancy(int level, const std::vector<HalfRGBA>& buffer) {
-    const int R = config_.resolution, mask = R - 1;
-    const size_t texels = texels_per_level();
-    std::vector<uint8_t> any(texels, 0);
-    const HalfRGBA* cells = buffer.data() + size_t(level) * level_cells();
-    for (size_t t = 0; t < texels; ++t)
-        for (int f = 0; f < kFaceCount; ++f)
-            if (has_opacity(cells[t * kFaceCount + size_t(f)])) {
-                any[t] = 1;
-                break;
-            }
-    uint8_t* out = occupancy_.data() + size_t(level) * texels;
-    for (int z = 0; z < R; ++z)
-        for (int y = 0; y < R; ++y)
-            for (int x = 0; x < R; ++x) {
-                uint8_t o = 0;
-                for (int c = 0; c < 8; ++c) {
-                    const int tx = (x + (c & 1)) & mask, ty = (y + ((c >> 1) & 1)) & mask, tz = (z + (c >> 2)) & mask;
-                    o |= any[(size_t(tz) * size_t(R) + size_t(ty)) * size_t(R) + size_t(tx)];
-                }
-                out[(size_t(z) * size_t(R) + size_t(y)) * size_t(R) + size_t(x)] = o;
-            }
+    build_occupancy_map(buffer.data() + size_t(level) * level_cells(), config_.resolution, true,
+                        occupancy_.data() + size_t(level) * texels_per_level());
 }
 
 size_t CascadedVoxelTexture::gbuffer_bytes() const {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include "accel/vct/occupancy_map.hpp"
 #include "core/util/error.hpp"
 #include "core/util/parallel.hpp"
 
@@ -90,35 +91,8 @@ void DenseMipTexture::build_mips(std::vector<std::vector<HalfRGBA>>& buffer) con
 }
 
 void DenseMipTexture::refresh_occupancy(const std::vector<std::vector<HalfRGBA>>& buffer) {
-    for (int k = 0; k < level_count(); ++k) {
-        const int r = resolution(k);
-        const std::vector<HalfRGBA>& cells = buffer[size_t(k)];
-        std::vector<uint8_t>& out = occupancy_[size_t(k)];
-        const size_t texels = out.size();
-        std::vector<uint8_t> any(texels, 0);
-        parallel_for(texels, size_t(1) << 14, [&](size_t b, size_t e) {
-            for (size_t t = b; t < e; ++t)
-                for (int f = 0; f < kFaceCount; ++f)
-                    if (has_opacity(cells[t * kFaceCount + size_t(f)])) {
-                        any[t] = 1;
-                        break;
-                    }
-        });
-        // A sample at the upper border reads its border texel twice: no neighbour beyond.
-        parallel_for(size_t(r), 1, [&](size_t z0, size_t z1) {
-            for (int z = int(z0); z < int(z1); ++z)
-                for (int y = 0; y < r; ++y)
-                    for (int x = 0; x < r; ++x) {
-                        uint8_t o = 0;
-                        for (int c = 0; c < 8; ++c) {
-                            const int tx = std::min(x + (c & 1), r - 1), ty = std::min(y + ((c >> 1) & 1), r - 1),
-                                      tz = std::min(z + (c >> 2), r - 1);
-                            o |= any[(size_t(tz) * size_t(r) + size_t(ty)) * size_t(r) + size_t(tx)];
-                        }
-                        out[(size_t(z) * size_t(r) + size_t(y)) * size_t(r) + size_t(x)] = o;
-                    }
-        });
-    }
+    for (int k = 0; k < level_count(); ++k)
+        build_occupancy_map(buffer[size_t(k)].data(), resolution(k), false, occupancy_[size_t(k)].data());
 }
 
 size_t DenseMipTexture::radiance_bytes() const {
