@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Writes experiments/sweep/task_costs.json from the task results of sweeps: for each
-experiment, the longest task of its quick and of its full plan in seconds (the `seconds`
-each task's result holds), taken only where every task of the plan has a result. An
+experiment, the longest task of its quick and of its full plan in seconds (a task's
+`cpu_seconds` when it ran on one thread, which other work on the machine does not inflate,
+else its wall `seconds`), taken only where every task of the plan has a result. An
 experiment or plan without all its results keeps the entry the current table has, so a
 table can be filled over several runs.
 
@@ -17,6 +18,12 @@ import sys
 TABLE = os.path.join(os.path.dirname(__file__), "..", "experiments", "sweep", "task_costs.json")
 
 
+def task_cost(result):
+    if result.get("threads") == 1 and "cpu_seconds" in result:
+        return result["cpu_seconds"]
+    return result["seconds"]
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--measured-on", required=True, help="the machine, threads per task and date")
@@ -28,7 +35,7 @@ def main():
         for plan, key in (("quick", "quick_longest_s"), ("full", "full_longest_s")):
             for name_dir in sorted(glob.glob(os.path.join(results, "*", "tasks", plan))):
                 name = os.path.basename(os.path.dirname(os.path.dirname(name_dir)))
-                seconds = [json.load(open(f))["seconds"] for f in glob.glob(os.path.join(name_dir, "*.json"))]
+                seconds = [task_cost(json.load(open(f))) for f in glob.glob(os.path.join(name_dir, "*.json"))]
                 tasks = subprocess.run([args.gilab, "experiment", "plan", name] + (["--quick"] if plan == "quick" else []),
                                        check=True, capture_output=True, text=True).stdout.splitlines()
                 if seconds and len(seconds) == len(tasks):

@@ -3,6 +3,7 @@
 #include "core/util/error.hpp"
 
 #include <malloc.h>
+#include <sys/resource.h>
 #include <unistd.h>
 #include <fstream>
 #include <sstream>
@@ -48,6 +49,13 @@ size_t read_status_kib(const char* field) {
     return 0;
 }
 }  // namespace
+
+double process_cpu_seconds() {
+    rusage usage{};
+    if (getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;
+    const auto seconds = [](const timeval& t) { return double(t.tv_sec) + double(t.tv_usec) * 1e-6; };
+    return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
 
 size_t peak_rss_bytes() { return read_status_kib("VmHWM") * 1024; }
 size_t current_rss_bytes() { return read_status_kib("VmRSS") * 1024; }

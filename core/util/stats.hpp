@@ -53,6 +53,9 @@ private:
     std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
+// CPU time (user + system) this process's threads have used so far: a task's cost that
+// other work on the machine does not inflate the way it inflates wall time.
+double process_cpu_seconds();
 size_t peak_rss_bytes();      // VmHWM of this process
 size_t current_rss_bytes();   // VmRSS of this process
 // Resets this process's peak-RSS mark (VmHWM) to its current RSS, so a peak read after a

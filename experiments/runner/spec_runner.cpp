@@ -203,6 +203,7 @@ nlohmann::json run_planned_task(const ExperimentSpec& spec, const SpecTask& task
                                 const ExperimentContext& ctx) {
     fs::create_directories(ctx.output_dir);  // the reference cache and tasks/ live there
     Stopwatch watch;
+    const double cpu_start = process_cpu_seconds();
     std::string names;
     for (const TaskVariant& v : task.variants) names += (names.empty() ? "" : ", ") + v.name;
     ctx.say("task " + std::to_string(task.id) + ": " + task.scene + ", " + names + ", " + task.axes.dump());
@@ -238,6 +239,7 @@ nlohmann::json run_planned_task(const ExperimentSpec& spec, const SpecTask& task
     }
     result["rows"] = rows;
     result["seconds"] = watch.elapsed_ms() / 1000.0;
+    result["cpu_seconds"] = process_cpu_seconds() - cpu_start;
     result["notes"] = notes;
     result["files"] = files;
     result["per_frame"] = per_frame;
@@ -291,6 +293,10 @@ fs::path spec_task_file(const fs::path& output_dir, int task_id, bool quick) {
     return output_dir / "tasks" / (quick ? "quick" : "full") / (std::to_string(task_id) + ".json");
 }
 
+fs::path spec_references_cost_file(const fs::path& output_dir, int task_id, bool quick) {
+    return output_dir / "tasks" / (quick ? "quick" : "full") / "references" / (std::to_string(task_id) + ".json");
+}
+
 std::optional<nlohmann::json> read_task_result(const ExperimentSpec& spec, const SpecTask& task, bool quick,
                                                uint64_t seed, const fs::path& file) {
     std::ifstream in(file);
@@ -338,6 +344,8 @@ nlohmann::json plan_entry(const ExperimentSpec& spec, const SpecTask& task, bool
 int render_task_references(const ExperimentSpec& spec, int task_id, const ExperimentContext& ctx) {
     const std::vector<SpecTask> tasks = plan_tasks(spec, ctx.quick);
     const SpecTask& task = planned_task(tasks, spec, task_id, ctx.quick);
+    Stopwatch watch;
+    const double cpu_start = process_cpu_seconds();
     TaskCache cache;
     std::vector<std::string> files;
     if (measures_relmse(spec, task)) {
@@ -354,6 +362,14 @@ int render_task_references(const ExperimentSpec& spec, int task_id, const Experi
                              reference_spp_of(spec, ctx.quick), cache};
         for (const ReferenceView& view : (*references)(call)) path_reference(ctx, view, files);
     }
+    // What rendering them cost, for the sweep's time figures (the task results do not hold it).
+    nlohmann::json cost = {{"seconds", watch.elapsed_ms() / 1000.0},
+                           {"cpu_seconds", process_cpu_seconds() - cpu_start},
+                           {"threads", ctx.threads > 0 ? ctx.threads : int(machine_description()["tbb_threads"])},
+                           {"references", files.size()}};
+    const fs::path cost_file = spec_references_cost_file(ctx.output_dir, task.id, ctx.quick);
+    fs::create_directories(cost_file.parent_path());
+    write_file_atomically(cost_file, cost.dump(2) + "\n");
     return int(files.size());
 }
 

@@ -16,6 +16,9 @@ namespace gilab {
 // results/NAME/tasks/{full|quick}/ID.json under the experiment's output directory: the
 // quick and the full plan number their tasks each from 0.
 std::filesystem::path spec_task_file(const std::filesystem::path& output_dir, int task_id, bool quick);
+// results/NAME/tasks/{full|quick}/references/ID.json: what rendering task ID's references
+// took (seconds, cpu_seconds, threads, references), written by `experiment references`.
+std::filesystem::path spec_references_cost_file(const std::filesystem::path& output_dir, int task_id, bool quick);
 
 // Runs task `task_id` of the plan (ctx.quick chooses the plan) and writes its result
 // file; returns the result. Throws Error naming the task for an id outside the plan.

@@ -91,10 +91,30 @@ std::optional<nlohmann::json> task_result(const Sweep& sweep, const SweepTask& t
 
 bool task_done(const Sweep& sweep, const SweepTask& task) { return task_result(sweep, task).has_value(); }
 
+namespace {
+
+std::optional<double> cost_of(const nlohmann::json& record) {
+    const auto number = [&](const char* key) { return record.contains(key) && record[key].is_number(); };
+    if (number("cpu_seconds") && record.value("threads", 0) == 1) return record["cpu_seconds"].get<double>();
+    if (number("seconds")) return record["seconds"].get<double>();
+    return std::nullopt;
+}
+
+}  // namespace
+
 std::optional<double> task_seconds(const Sweep& sweep, const SweepTask& task) {
     const std::optional<nlohmann::json> result = task_result(sweep, task);
-    if (!result || !result->contains("seconds") || !(*result)["seconds"].is_number()) return std::nullopt;
-    return (*result)["seconds"].get<double>();
+    return result ? cost_of(*result) : std::nullopt;
+}
+
+std::optional<double> references_seconds(const Sweep& sweep, const SweepTask& task) {
+    std::ifstream in(spec_references_cost_file(sweep.results_root / task.experiment, task.id, sweep.quick));
+    if (!in) return std::nullopt;
+    try {
+        return cost_of(nlohmann::json::parse(in));
+    } catch (const nlohmann::json::exception&) {
+        return std::nullopt;  // a damaged record estimates nothing
+    }
 }
 
 double wall_seconds_on(std::vector<double> seconds, int slots) {

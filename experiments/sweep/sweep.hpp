@@ -76,8 +76,13 @@ std::vector<std::string> run_task_arguments(const Sweep& sweep, const SweepTask&
 std::vector<SweepTask> reference_tasks(const Sweep& sweep, const std::vector<SweepTask>& tasks);
 std::vector<std::string> references_arguments(const Sweep& sweep, const SweepTask& task);
 
-// The time the task's result says it took (its `seconds`), or nothing without a result.
+// What the task cost by its result: its CPU time when it ran on one thread (other work on
+// the machine does not inflate that, as it inflates wall time), else its wall time
+// (`seconds`); nothing without a result.
 std::optional<double> task_seconds(const Sweep& sweep, const SweepTask& task);
+// The same for rendering the references of reference task `task` (reference_tasks), from
+// the cost file `experiment references` writes; nothing when they were not rendered.
+std::optional<double> references_seconds(const Sweep& sweep, const SweepTask& task);
 
 // The wall time of tasks taking `seconds` each on `slots` machines that each run one task
 // at a time, the longest tasks first, each to the machine free first (LPT list

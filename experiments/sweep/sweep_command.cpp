@@ -79,13 +79,15 @@ std::string duration(double seconds) {
     return text;
 }
 
-// The task times the results hold: their sum, the longest task, and the wall time they
-// would take on 1, 4 and 16 machines running one task each at a time.
+// The times the results hold (CPU time of one-thread tasks, else wall time): the tasks'
+// sum and longest, the references' sum, and the wall time on 1, 4 and 16 machines running
+// one process each at a time — the references first, then the tasks, as sweeps run them.
 void print_measured_times(const Sweep& sweep, std::ostream& out) {
-    std::vector<double> seconds;
+    std::vector<double> seconds, reference_seconds;
     double longest = 0;
     std::string longest_task;
-    for (const SweepTask& t : sweep_tasks(sweep)) {
+    const std::vector<SweepTask> all = sweep_tasks(sweep);
+    for (const SweepTask& t : all) {
         const std::optional<double> s = task_seconds(sweep, t);
         if (!s) continue;
         seconds.push_back(*s);
@@ -94,15 +96,24 @@ void print_measured_times(const Sweep& sweep, std::ostream& out) {
             longest_task = t.experiment + " task " + std::to_string(t.id);
         }
     }
+    for (const SweepTask& t : reference_tasks(sweep, all))
+        if (const std::optional<double> s = references_seconds(sweep, t)) reference_seconds.push_back(*s);
     if (seconds.empty()) return;
-    double sum = 0;
-    for (double s : seconds) sum += s;
-    out << "task time of the " << seconds.size() << " results: " << duration(sum) << " in all, longest "
-        << duration(longest) << " (" << longest_task << "); one task at a time per machine, longest first: ";
-    for (int machines : {1, 4, 16})
-        out << machines << (machines == 1 ? " machine " : " machines ") << duration(wall_seconds_on(seconds, machines))
-            << (machines == 16 ? "" : ", ");
-    out << " (references rendered before the tasks, as sweeps do, are not in the results)" << std::endl;
+    const auto sum = [](const std::vector<double>& v) {
+        double total = 0;
+        for (double s : v) total += s;
+        return total;
+    };
+    out << "task time of the " << seconds.size() << " results (CPU time of one-thread tasks, else wall time): "
+        << duration(sum(seconds)) << " in all, longest " << duration(longest) << " (" << longest_task << "); "
+        << reference_seconds.size() << " reference group(s) rendered: " << duration(sum(reference_seconds))
+        << "; one process at a time per machine, references first, longest first: ";
+    for (int machines : {1, 4, 16}) {
+        const double wall = (reference_seconds.empty() ? 0.0 : wall_seconds_on(reference_seconds, machines)) +
+                            wall_seconds_on(seconds, machines);
+        out << machines << (machines == 1 ? " machine " : " machines ") << duration(wall) << (machines == 16 ? "" : ", ");
+    }
+    out << std::endl;
 }
 
 int show_status(const Sweep& sweep, std::ostream& out) {

@@ -103,6 +103,11 @@ TEST_F(SweepLocal, GivesTheTablesOfGilabExperimentAndSkipsDoneTasksWhenRunAgain)
     for (const auto& entry : fs::directory_iterator(results / ".references"))
         stored += entry.path().extension() == ".exr";
     EXPECT_EQ(stored, 1u);
+    // What rendering them and each task cost is kept for `sweep status`.
+    const nlohmann::json cost = read_json(results / "pm-radius-sweep" / "tasks" / "quick" / "references" / "0.json");
+    EXPECT_EQ(cost["references"], 1) << cost;
+    EXPECT_GT(cost["cpu_seconds"].get<double>(), 0.0) << cost;
+    EXPECT_GT(read_json(results / "pm-radius-sweep" / "tasks" / "quick" / "1.json")["cpu_seconds"].get<double>(), 0.0);
     for (int id = 0; id < 4; ++id) {
         std::ifstream log(results / ".sweep" / "logs" / ("pm-radius-sweep." + std::to_string(id) + ".log"));
         const std::string text{std::istreambuf_iterator<char>(log), std::istreambuf_iterator<char>()};
@@ -151,7 +156,8 @@ TEST_F(SweepLocal, AFailedTaskIsMissingFromTheMergeUntilResumed) {
     EXPECT_TRUE(read_json(results / "pm-radius-sweep" / "results.json")["config"]["effective"]["tasks_missing"].empty());
     const std::string done = run_gilab({"sweep", "status", (results / ".sweep").string()}).output;
     EXPECT_TRUE(contains(done, "total: 7 done, 0 running")) << done;
-    EXPECT_TRUE(contains(done, "task time of the 7 results: ")) << done;
+    EXPECT_TRUE(contains(done, "task time of the 7 results (CPU time of one-thread tasks, else wall time): ")) << done;
+    EXPECT_TRUE(contains(done, "1 reference group(s) rendered: ")) << done;
     EXPECT_TRUE(contains(done, "16 machines ")) << done;
 }
 
