@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <mutex>
 #include <string>
 #include "accel/vct/occupancy_map.hpp"
 #include "core/util/error.hpp"
@@ -19,9 +20,10 @@ void CascadeConfig::validate() const {
         throw Error(where, "voxel size must be positive and finite, got " + std::to_string(voxel_size));
     if (!std::isfinite(anchor.x) || !std::isfinite(anchor.y) || !std::isfinite(anchor.z))
         throw Error(where, "anchor must be finite");
-    // Per cell: the G-buffer (20 bytes) and two RGBA16F radiance values.
+    // Per cell two RGBA16F radiance values; per texel a G-buffer slot (its pool entry
+    // only when occupied) and an occupancy byte.
     double cells = double(levels) * double(resolution) * double(resolution) * double(resolution) * kFaceCount;
-    if (cells * 36.0 > double(size_t(8) << 30))
+    if (cells * (16.0 + 5.0 / kFaceCount) > double(size_t(8) << 30))
         throw Error(where, std::to_string(levels) + " levels of " + std::to_string(resolution) +
                                "³ would need more than 8 GiB");
 }
@@ -32,8 +34,9 @@ CascadedVoxelTexture::CascadedVoxelTexture(const CascadeConfig& config) : config
     own_inner_.assign(size_t(config_.levels), VoxelBox{});
     gbuffer_clear_.assign(size_t(config_.levels), 1);
     const size_t n = cell_count();
-    opacity.assign(n, 0.0f);
-    surface.assign(n, PackedSurface{});
+    slots_.assign(voxel_count(), kEmptySlot);
+    pools_.assign(size_t(config_.levels), {});
+    freed_.assign(size_t(config_.levels), 0);
     direct.assign(n, HalfRGBA{});
     radiance.assign(n, HalfRGBA{});
     occupancy_.assign(size_t(config_.levels) * texels_per_level(), 1);
@@ -94,11 +97,12 @@ void CascadedVoxelTexture::place(int level, const IVec3& origin) {
     gilab::parallel_for(size_t(R), 1, [&](size_t z0, size_t z1) {
         for (size_t z = z0; z < z1; ++z) {
             const size_t first = index(0, level, UVec3(0, 0, uint32_t(z))), n = size_t(R) * size_t(R) * kFaceCount;
-            std::fill_n(opacity.begin() + ptrdiff_t(first), n, 0.0f);
-            std::fill_n(surface.begin() + ptrdiff_t(first), n, PackedSurface{});
             for (auto* a : {&direct, &radiance}) std::fill_n(a->begin() + ptrdiff_t(first), n, HalfRGBA{});
         }
     });
+    std::fill_n(slots_.begin() + ptrdiff_t(size_t(level) * texels_per_level()), texels_per_level(), kEmptySlot);
+    pools_[size_t(level)].clear();
+    freed_[size_t(level)] = 0;
     std::fill_n(occupancy_.begin() + ptrdiff_t(size_t(level) * texels_per_level()), texels_per_level(), uint8_t(1));
     gbuffer_clear_[size_t(level)] = true;
 }
@@ -134,10 +138,29 @@ void CascadedVoxelTexture::for_each_run(int level, const VoxelBox& box, Fn&& fn)
 
 void CascadedVoxelTexture::clear_gbuffer(int level, const VoxelBox& box) {
     if (gbuffer_clear_[size_t(level)]) return;  // nothing written since the level was cleared
-    for_each_run(level, box, [&](size_t i, size_t n) {
-        std::fill_n(opacity.begin() + ptrdiff_t(i), n, 0.0f);
-        std::fill_n(surface.begin() + ptrdiff_t(i), n, PackedSurface{});
+    for_each_voxel(box.intersect(region(level)), [&](const IVec3& v) {
+        uint32_t& slot = slots_[slot_index(level, v)];
+        if (slot == kEmptySlot) return;
+        slot = kEmptySlot;
+        ++freed_[size_t(level)];
     });
+}
+
+void CascadedVoxelTexture::compact_if_sparse(int level) {
+    std::vector<PackedVoxel>& pool = pools_[size_t(level)];
+    if (freed_[size_t(level)] * 2 <= pool.size()) return;
+    // Live entries in (z, y, x) order of the region, which also keeps the result
+    // independent of the order the voxelizer's threads wrote them in.
+    std::vector<PackedVoxel> live;
+    live.reserve(pool.size() - freed_[size_t(level)]);
+    for_each_voxel(region(level), [&](const IVec3& v) {
+        uint32_t& slot = slots_[slot_index(level, v)];
+        if (slot == kEmptySlot) return;
+        live.push_back(pool[slot]);
+        slot = uint32_t(live.size() - 1);
+    });
+    pool = std::move(live);
+    freed_[size_t(level)] = 0;
 }
 
 void CascadedVoxelTexture::clear_radiance(int level, const VoxelBox& box) {
@@ -198,28 +221,51 @@ std::vector<VoxelBox> CascadedVoxelTexture::scroll(int level, const IVec3& new_o
 }
 
 void CascadedVoxelTexture::write(int level, const AnisotropicVoxel& voxel) {
-    gbuffer_clear_[size_t(level)] = false;
     if (!contains(level, voxel.coord))
         throw Error("cascaded voxel texture", "voxel outside level " + std::to_string(level) + "'s region");
-    const Vec3 center = gilab::voxel_center(lattice(level), voxel.coord);
-    const float size = float(voxel_size(level));
-    const size_t first = index_of_voxel(0, level, voxel.coord);
-    for (int f = 0; f < kFaceCount; ++f) {
-        const VoxelFaceData& d = voxel.faces[size_t(f)];
-        opacity[first + size_t(f)] = d.opacity;
-        surface[first + size_t(f)] = pack_surface(d, center, size);
+    gbuffer_clear_[size_t(level)] = false;
+    std::vector<PackedVoxel>& pool = pools_[size_t(level)];
+    uint32_t& slot = slots_[slot_index(level, voxel.coord)];
+    if (slot == kEmptySlot) {
+        if (pool.size() >= kEmptySlot) throw Error("cascaded voxel texture", "G-buffer pool full");
+        slot = uint32_t(pool.size());
+        pool.push_back(pack_voxel(voxel, lattice(level)));
+    } else {
+        pool[slot] = pack_voxel(voxel, lattice(level));
     }
+}
+
+const PackedVoxel* CascadedVoxelTexture::gbuffer_voxel(int level, const IVec3& v) const {
+    if (!contains(level, v)) return nullptr;
+    const uint32_t slot = slots_[slot_index(level, v)];
+    return slot == kEmptySlot ? nullptr : &pools_[size_t(level)][slot];
+}
+
+float CascadedVoxelTexture::opacity_of_cell(size_t cell) const {
+    const uint32_t slot = slots_.at(cell / kFaceCount);
+    const size_t level = cell / level_cells();
+    return slot == kEmptySlot ? 0.0f : pools_[level][slot].opacity[cell % kFaceCount];
+}
+
+FragmentVoxelizeStats CascadedVoxelTexture::voxelize_boxes(int level, const FragmentVoxelizer& voxelizer,
+                                                           const std::vector<VoxelBox>& boxes,
+                                                           const VoxelBox& exclude) {
+    FragmentVoxelizeStats stats;
+    std::mutex pool_lock;  // the voxelizer emits from worker threads; the pool grows one at a time
+    voxelizer.voxelize_each(lattice(level), boxes, [&](const AnisotropicVoxel& v) {
+        const std::lock_guard<std::mutex> hold(pool_lock);
+        write(level, v);
+    }, &stats, exclude);
+    compact_if_sparse(level);
+    return stats;
 }
 
 FragmentVoxelizeStats CascadedVoxelTexture::voxelize(int level, const FragmentVoxelizer& voxelizer,
                                                      const VoxelBox& box) {
     const VoxelBox b = box.intersect(region(level));
     clear_gbuffer(level, b);
-    FragmentVoxelizeStats stats;
-    if (b.empty()) return stats;
-    // Voxels of one brick are written by one task and bricks never share a voxel.
-    voxelizer.voxelize_each(lattice(level), b, [&](const AnisotropicVoxel& v) { write(level, v); }, &stats);
-    return stats;
+    if (b.empty()) return {};
+    return voxelize_boxes(level, voxelizer, {b}, VoxelBox{});
 }
 
 std::vector<VoxelBox> subtract(const VoxelBox& a, const VoxelBox& b) {
@@ -253,10 +299,8 @@ FragmentVoxelizeStats CascadedVoxelTexture::voxelize_own(int level, const Fragme
     own_inner_[size_t(level)] = inner;
     const VoxelBox b = box.intersect(region(level));
     clear_gbuffer(level, b);
-    FragmentVoxelizeStats stats;
-    if (b.empty()) return stats;
-    voxelizer.voxelize_each(lattice(level), b, [&](const AnisotropicVoxel& v) { write(level, v); }, &stats, inner);
-    return stats;
+    if (b.empty()) return {};
+    return voxelize_boxes(level, voxelizer, {b}, inner);
 }
 
 FragmentVoxelizeStats CascadedVoxelTexture::follow_inner(int level, const FragmentVoxelizer& voxelizer,
@@ -274,15 +318,18 @@ FragmentVoxelizeStats CascadedVoxelTexture::follow_inner(int level, const Fragme
             pending.push_back(part);
         }
     }
-    if (pending.empty()) return stats;
-    voxelizer.voxelize_each(lattice(level), pending, [&](const AnisotropicVoxel& v) { write(level, v); }, &stats, inner);
-    return stats;
+    if (pending.empty()) {
+        compact_if_sparse(level);
+        return stats;
+    }
+    return voxelize_boxes(level, voxelizer, pending, inner);
 }
 
 bool CascadedVoxelTexture::occupied(int level, const IVec3& v) const {
-    if (!contains(level, v)) return false;
-    for (int f = 0; f < kFaceCount; ++f)
-        if (opacity[index_of_voxel(f, level, v)] > 0.0f) return true;
+    const PackedVoxel* voxel = gbuffer_voxel(level, v);
+    if (!voxel) return false;
+    for (float a : voxel->opacity)
+        if (a > 0.0f) return true;
     return false;
 }
 
@@ -329,8 +376,15 @@ void CascadedVoxelTexture::refresh_occupancy(int level, const std::vector<HalfRG
 }
 
 size_t CascadedVoxelTexture::gbuffer_bytes() const {
-    return opacity.size() * sizeof(float) +
-           surface.size() * sizeof(PackedSurface);
+    size_t bytes = slots_.capacity() * sizeof(uint32_t);
+    for (const auto& pool : pools_) bytes += pool.capacity() * sizeof(PackedVoxel);
+    return bytes;
+}
+
+size_t CascadedVoxelTexture::occupancy_encoding_bytes() const {
+    size_t bytes = slots_.capacity() * sizeof(uint32_t);
+    for (const auto& pool : pools_) bytes += pool.capacity() * sizeof(float) * kFaceCount;
+    return bytes;
 }
 
 size_t CascadedVoxelTexture::radiance_bytes() const {

@@ -90,10 +90,19 @@ public:
     }
     size_t cell_count() const { return size_t(config_.levels) * level_cells(); }
 
-    // ---- G-buffer
+    // ---- G-buffer: sparse, as only surface voxels carry one. Per level a slot per texel
+    // (kEmptySlot, or the index of the voxel in the level's pool of PackedVoxel: the six
+    // faces' opacity and packed surface, accel/vct/packed_surface.hpp). Clearing frees
+    // slots; a pool holding more freed entries than live ones is compacted.
+    static constexpr uint32_t kEmptySlot = 0xFFFFFFFFu;
     void clear_gbuffer(int level, const VoxelBox& box);         // box ∩ region
     void clear_radiance(int level, const VoxelBox& box);        // both radiance buffers
+    // Not thread-safe (the voxelize calls serialise their voxelizer's writes).
     void write(int level, const AnisotropicVoxel& voxel);       // must lie in the region
+    // The G-buffer voxel at world voxel v of the level, or nullptr (empty or outside).
+    const PackedVoxel* gbuffer_voxel(int level, const IVec3& v) const;
+    // The opacity of cell `cell` (index()), 0 when its voxel is empty.
+    float opacity_of_cell(size_t cell) const;
     // Voxelizes box ∩ region of the level into the G-buffer (clearing it first).
     FragmentVoxelizeStats voxelize(int level, const FragmentVoxelizer& voxelizer, const VoxelBox& box);
     FragmentVoxelizeStats voxelize(int level, const FragmentVoxelizer& voxelizer) {
@@ -130,30 +139,41 @@ public:
 
     // ---- memory
     size_t voxel_count() const { return size_t(config_.levels) * texels_per_level(); }
-    size_t gbuffer_bytes() const;
+    size_t gbuffer_bytes() const;   // slots and pools (their capacity)
     size_t radiance_bytes() const;  // both radiance buffers and the occupancy map
+    // What encodes occupancy alone: the slots and the pools' float opacities.
+    size_t occupancy_encoding_bytes() const;
     size_t bytes() const { return gbuffer_bytes() + radiance_bytes(); }
     // What the paper's Tables 5/6 count: opacity only, one byte per voxel per face.
     size_t opacity_bytes_paper() const { return voxel_count() * size_t(kFaceCount); }
 
-    // Attributes, one allocation each. G-buffer: opacity and the packed surface (albedo,
-    // normal, position: accel/vct/packed_surface.hpp) — what the light injection reads;
-    // emitters are lit by shadow rays, not injected, so the voxelizer's emission is not
-    // kept. Radiance (V-buffer), premultiplied RGBA16F with
-    // alpha the opacity: `direct` (direct light only) and `radiance` (direct + voxel
-    // bounce), both anisotropically filtered from finer levels.
-    std::vector<float> opacity;
-    std::vector<PackedSurface> surface;
+    // Radiance (V-buffer), one allocation each, premultiplied RGBA16F with alpha the
+    // opacity: `direct` (direct light only) and `radiance` (direct + voxel bounce), both
+    // anisotropically filtered from finer levels. (The G-buffer keeps what the light
+    // injection reads; emitters are lit by shadow rays, not injected, so the voxelizer's
+    // emission is not kept.)
     std::vector<HalfRGBA> direct, radiance;
 
 private:
     template <class Fn>
     void for_each_run(int level, const VoxelBox& box, Fn&& fn) const;
+    size_t slot_index(int level, const IVec3& v) const {
+        const UVec3 t = texel_of(v);
+        const size_t R = size_t(config_.resolution);
+        return ((size_t(level) * R + t.z) * R + t.y) * R + t.x;
+    }
+    // Voxelizes `boxes` minus `exclude` into the level with the writes serialised.
+    FragmentVoxelizeStats voxelize_boxes(int level, const FragmentVoxelizer& voxelizer,
+                                         const std::vector<VoxelBox>& boxes, const VoxelBox& exclude);
+    void compact_if_sparse(int level);
     CascadeConfig config_;
     std::vector<IVec3> origins_;
     std::vector<VoxelBox> own_inner_;  // inner box excluded by the last voxelize_own / follow_inner
     std::vector<char> gbuffer_clear_;  // per level: nothing written since the last full clear
     std::vector<uint8_t> occupancy_;   // see refresh_occupancy
+    std::vector<uint32_t> slots_;                  // per level and texel, see the G-buffer
+    std::vector<std::vector<PackedVoxel>> pools_;  // per level
+    std::vector<size_t> freed_;                    // per level: pool entries no slot names
 };
 
 // a − b as disjoint boxes (at most six).

@@ -60,7 +60,7 @@ const std::map<std::string, std::string>& encodings() {
         {"MSVO", "OctoMap OcTree nodes (float log-odds + child-pointer array), memoryUsage()"},
         {"SVDAG", "32-bit words: per unique node a child-mask word + one 32-bit pointer per child (all leaves merged into one)"},
         {"OpenVDB", "OpenVDB tree (root, internal and 8³ leaf nodes), memUsage()"},
-        {"cascaded", "32-bit float opacity per face, 6 faces per cell"}};
+        {"cascaded", "32-bit slot per cell + 32-bit float opacity per face of each occupied voxel"}};
     return e;
 }
 
@@ -213,7 +213,7 @@ SceneFigures measure_structures(const ExperimentContext& ctx, const Scene& scene
     double occupied = 0;
     for (int k = 0; k < config.levels; ++k) occupied += double(cascade.occupied_voxels(k));
     out.by_structure["cascaded"] = {double(cascade.voxel_count()), occupied, median(t_cascade),
-                                    double(cascade.opacity.size() * sizeof(float)), double(cascade.bytes())};
+                                    double(cascade.occupancy_encoding_bytes()), double(cascade.bytes())};
     out.by_structure["cascaded"].ms_fragment = median(t_cascade);  // needs per-face attributes: fragments only
     ctx.say(scene.name + " " + std::to_string(resolution) + "³: " + std::to_string(list.size()) + " voxels, dense " +
             std::to_string(median(t_dense)) + " ms, cascaded (" + std::to_string(config.levels) + " levels) " +
@@ -426,8 +426,8 @@ std::vector<std::string> structure_notes(std::vector<std::string> more) {
         "Cascades: 32³ per level, levels = log2(resolution/32) + 1, finest voxel = the grid's voxel, centred on the "
         "scene camera if it is inside the scene, else on the scene's centre.",
         "Memory: each structure charged its real encoding of occupancy (column 'encoding'): the 3D texture 1 B per "
-        "cell; SVO, SVDAG, MSVO and OpenVDB exactly what our build holds; the cascades their float opacity per face "
-        "(the paper counts 1 B per face: 6 B per cell). 'all arrays held' adds, for the cascades, every G-buffer "
+        "cell; SVO, SVDAG, MSVO and OpenVDB exactly what our build holds; the cascades their G-buffer slots and the float "
+        "opacity per face of their occupied voxels (the paper counts 1 B per face: 6 B per cell). 'all arrays held' adds, for the cascades, every G-buffer "
         "attribute and both radiance buffers. The paper's MB are 2²⁰ B (its 3D texture at 128³, 2 097 152 B, is "
         "printed as 2 MB), ours 10⁶ B; its bytes per node are implied by dividing its memory by its own count."};
     notes.insert(notes.end(), more.begin(), more.end());

@@ -162,14 +162,11 @@ FaceInput face_input(float opacity, const PackedSurface& s, const Vec3& center, 
     return {opacity, unpack_albedo(s), unpack_normal(s), unpack_position(s, center, voxel_size)};
 }
 
+VoxelInput input_of(const PackedVoxel& voxel, const VoxelLattice& lattice);
+
 VoxelInput input_of(const CascadedVoxelTexture& t, int level, const IVec3& v) {
-    VoxelInput in;
-    const Vec3 center = voxel_center(t.lattice(level), v);
-    const float size = float(t.voxel_size(level));
-    const size_t first = t.index_of_voxel(0, level, v);
-    for (int f = 0; f < kFaceCount; ++f)
-        in[size_t(f)] = face_input(t.opacity[first + size_t(f)], t.surface[first + size_t(f)], center, size);
-    return in;
+    const PackedVoxel* voxel = t.gbuffer_voxel(level, v);
+    return voxel ? input_of(*voxel, t.lattice(level)) : VoxelInput{};
 }
 
 VoxelInput input_of(const PackedVoxel& voxel, const VoxelLattice& lattice) {

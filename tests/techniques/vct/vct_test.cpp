@@ -182,7 +182,7 @@ TEST(ConeTracer, EmptySpaceGivesNothingAndAWallSaturates) {
         t.place(k, t.origin_for(DVec3(0.0), k));
         t.voxelize(k, vox);
     }
-    for (size_t i = 0; i < t.cell_count(); ++i) t.radiance[i] = to_half_rgba(Vec4(Vec3(2.0f * t.opacity[i]), t.opacity[i]));
+    for (size_t i = 0; i < t.cell_count(); ++i) t.radiance[i] = to_half_rgba(Vec4(Vec3(2.0f * t.opacity_of_cell(i)), t.opacity_of_cell(i)));
     for (int k = 1; k < 4; ++k) t.downsample(k, t.radiance);
     for (int k = 0; k < 4; ++k) t.refresh_occupancy(k, t.radiance);
     VoxelConeView view = VoxelConeView::cascade(t, t.radiance);
@@ -315,9 +315,10 @@ TEST(VctTechnique, UpdateStrategyFollowsTheViewer) {
     const CascadedVoxelTexture& e = *everything->cascade();
     for (int k = 0; k < 4; ++k) {
         ASSERT_EQ(s.origin(k), e.origin(k)) << "level " << k;
-        for (const IVec3& v : e.occupied_in(k, e.region(k)))
-            for (int f = 0; f < kFaceCount; ++f)
-                ASSERT_EQ(s.opacity[s.index_of_voxel(f, k, v)], e.opacity[e.index_of_voxel(f, k, v)]);
+        for (const IVec3& v : e.occupied_in(k, e.region(k))) {
+            ASSERT_NE(s.gbuffer_voxel(k, v), nullptr) << "level " << k;
+            ASSERT_EQ(s.gbuffer_voxel(k, v)->opacity, e.gbuffer_voxel(k, v)->opacity) << "level " << k;
+        }
         EXPECT_EQ(s.occupied_voxels(k), e.occupied_voxels(k));
     }
 }
@@ -415,8 +416,8 @@ TEST(VctTechnique, DynamicMeshesAreNotVoxelized) {
     auto without = prepared(make_cornell_box(), {{"dense_resolution", 64}, {"diffuse", false}});
     const CascadedVoxelTexture& a = *with->cascade();
     const CascadedVoxelTexture& b = *without->cascade();
-    ASSERT_EQ(a.opacity.size(), b.opacity.size());
-    EXPECT_TRUE(std::equal(a.opacity.begin(), a.opacity.end(), b.opacity.begin()));
+    ASSERT_EQ(a.cell_count(), b.cell_count());
+    for (size_t i = 0; i < a.cell_count(); ++i) ASSERT_EQ(a.opacity_of_cell(i), b.opacity_of_cell(i)) << "cell " << i;
     EXPECT_EQ(with->stats().get("voxelized_triangles") + 2, with->stats().get("triangles"));
     // Still seen by the primary rays: the image differs.
     with->update(0.5);
