@@ -36,9 +36,8 @@ DirectLighting::DirectLighting(const SceneFrame& frame, const std::vector<Materi
 }
 
 template <class Weight>
-Vec3 DirectLighting::accumulate(const RayTracer& tracer, const Vec3& p, const Vec3& ng, float offset, Rng& rng,
-                                Weight&& weight) const {
-    Vec3 sum(0.0f);
+void DirectLighting::queries(const Vec3& p, const Vec3& ng, float offset, Rng& rng, Weight&& weight,
+                             std::vector<ShadowQuery>& out) const {
     const Vec3 origin = p + offset * ng;
     for (const PunctualLight& l : punctual_) {
         Vec3 wi, Li;
@@ -61,7 +60,7 @@ Vec3 DirectLighting::accumulate(const RayTracer& tracer, const Vec3& p, const Ve
         if (glm::dot(wi, ng) <= 0.0f) continue;
         Vec3 f = weight(wi);
         if (max_component(f) <= 0.0f) continue;
-        if (!tracer.occluded(ray)) sum += f * Li;
+        out.push_back({ray, f * Li});
     }
     if (!distribution_.empty()) {
         const int n = area_samples_;
@@ -82,11 +81,26 @@ Vec3 DirectLighting::accumulate(const RayTracer& tracer, const Vec3& p, const Ve
             if (max_component(f) <= 0.0f) continue;
             float pdf_area = distribution_.pmf(index) / e.area;
             if (!(pdf_area > 0.0f)) continue;
-            if (tracer.occluded(segment(origin, q))) continue;
-            sum += f * e.radiance * (cos_light / (dist2 * pdf_area * float(n)));
+            out.push_back({segment(origin, q), f * e.radiance * (cos_light / (dist2 * pdf_area * float(n)))});
         }
     }
+}
+
+template <class Weight>
+Vec3 DirectLighting::accumulate(const RayTracer& tracer, const Vec3& p, const Vec3& ng, float offset, Rng& rng,
+                                Weight&& weight) const {
+    thread_local std::vector<ShadowQuery> pending;
+    pending.clear();
+    queries(p, ng, offset, rng, weight, pending);
+    Vec3 sum(0.0f);
+    for (const ShadowQuery& q : pending)
+        if (!tracer.occluded(q.ray)) sum += q.contribution;
     return sum;
+}
+
+void DirectLighting::irradiance_queries(const Vec3& p, const Vec3& n, float offset, Rng& rng,
+                                        std::vector<ShadowQuery>& out) const {
+    queries(p, n, offset, rng, [&](const Vec3& wi) { return Vec3(std::max(0.0f, glm::dot(n, wi))); }, out);
 }
 
 Vec3 DirectLighting::irradiance(const RayTracer& tracer, const Vec3& p, const Vec3& n, float offset, Rng& rng) const {

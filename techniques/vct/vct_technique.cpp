@@ -72,6 +72,18 @@ std::array<int, kFaceCount> sides(const VoxelInput& in) {
     return of;
 }
 
+// Calls fn(begin, end) over [0, count) in parallel, in blocks of exactly `block` (the last
+// shorter): a block's shadow-ray stream then never depends on the thread count, so
+// neither does anything Embree's stream traversal decides.
+void parallel_blocks(size_t count, size_t block, const std::function<void(size_t, size_t)>& fn) {
+    parallel_for((count + block - 1) / block, 1, [&](size_t b, size_t e) {
+        for (size_t j = b; j < e; ++j) fn(j * block, std::min(count, (j + 1) * block));
+    });
+}
+
+// Voxels per shadow-ray stream of the light injection (about 100 rays per light).
+constexpr size_t kInjectionBlock = 32;
+
 struct Shading {
     const RayTracer& tracer;
     const DirectLighting& lighting;
@@ -79,26 +91,52 @@ struct Shading {
     const ConeSet& injection_set;
     Bounds3 bounds;  // of the voxelized geometry
 
-    // Direct light leaving each face (premultiplied by its opacity).
-    VoxelRadiance direct(const VoxelInput& in, int level, const IVec3& v, float voxel, uint64_t& faces_lit) const {
-        VoxelRadiance out{};
-        Vec3 E[kFaceCount];
-        for (int f = 0; f < kFaceCount; ++f) {
-            const FaceInput& fi = in[size_t(f)];
-            if (!(fi.opacity > 0)) continue;
-            int g = same_as_earlier(in, f);
-            if (g >= 0) {
-                E[f] = E[g];
-            } else {
+    // Direct light leaving each face (premultiplied by its opacity) of the voxels
+    // voxel(0 … n−1) → {input, world coordinates}, into out[0 … n−1]. Faces on one side
+    // share one irradiance (same_as_earlier); the shadow rays of all the faces go to
+    // Embree as one stream, and each face sums its unblocked queries in their order.
+    template <class VoxelAt>
+    void direct(size_t n, int level, float voxel, VoxelAt&& voxel_at, VoxelRadiance* out, uint64_t& faces_lit) const {
+        thread_local std::vector<ShadowQuery> queries;
+        thread_local std::vector<uint32_t> owner;  // voxel · 6 + face of each query
+        thread_local std::vector<uint8_t> blocked;
+        thread_local std::vector<VoxelInput> inputs;
+        queries.clear();
+        owner.clear();
+        inputs.resize(n);
+        for (size_t i = 0; i < n; ++i) {
+            const auto [in, v] = voxel_at(i);
+            inputs[i] = in;
+            for (int f = 0; f < kFaceCount; ++f) {
+                const FaceInput& fi = in[size_t(f)];
+                if (!(fi.opacity > 0) || same_as_earlier(in, f) >= 0) continue;
                 Rng rng = voxel_rng(settings.seed, level, v, f);
                 float offset = std::max(1e-3f * voxel, 4.0f * ray_epsilon(fi.position));
-                E[f] = lighting.irradiance(tracer, fi.position, fi.normal, offset, rng);
+                lighting.irradiance_queries(fi.position, fi.normal, offset, rng, queries);
+                owner.resize(queries.size(), uint32_t(i * kFaceCount + size_t(f)));
                 ++faces_lit;
             }
-            Vec3 L = fi.albedo * kInvPi * E[f];
-            out[size_t(f)] = Vec4(L * fi.opacity, fi.opacity);
         }
-        return out;
+        thread_local std::vector<Ray> rays;
+        rays.resize(queries.size());
+        for (size_t q = 0; q < queries.size(); ++q) rays[q] = queries[q].ray;
+        blocked.resize(queries.size());
+        tracer.occluded(rays, blocked);
+        thread_local std::vector<Vec3> E;
+        E.assign(n * kFaceCount, Vec3(0.0f));
+        for (size_t q = 0; q < queries.size(); ++q)
+            if (!blocked[q]) E[owner[q]] += queries[q].contribution;
+        for (size_t i = 0; i < n; ++i) {
+            const VoxelInput& in = inputs[i];
+            out[i] = VoxelRadiance{};
+            for (int f = 0; f < kFaceCount; ++f) {
+                const FaceInput& fi = in[size_t(f)];
+                if (!(fi.opacity > 0)) continue;
+                const int g = same_as_earlier(in, f);
+                const Vec3 L = fi.albedo * kInvPi * E[i * kFaceCount + size_t(g >= 0 ? g : f)];
+                out[i][size_t(f)] = Vec4(L * fi.opacity, fi.opacity);
+            }
+        }
     }
 
     // Direct + one bounce gathered by the injection cones from `view` (the direct
@@ -435,10 +473,11 @@ void VctTechnique::light_cascade(const std::vector<bool>& levels) {
         auto& values = own_direct[size_t(k)];
         values.resize(list.size());
         const float voxel = float(t.voxel_size(k));
-        parallel_for(list.size(), 16, [&](size_t b, size_t e) {
+        parallel_blocks(list.size(), kInjectionBlock, [&](size_t b, size_t e) {
             uint64_t local = 0;
+            shading.direct(e - b, k, voxel, [&](size_t i) { return std::pair(input_of(t, k, list[b + i]), list[b + i]); },
+                           values.data() + b, local);
             for (size_t i = b; i < e; ++i) {
-                values[i] = shading.direct(input_of(t, k, list[i]), k, list[i], voxel, local);
                 const size_t first = t.index_of_voxel(0, k, list[i]);
                 for (int f = 0; f < kFaceCount; ++f) t.direct[first + size_t(f)] = to_half_rgba(values[i][size_t(f)]);
             }
@@ -511,10 +550,11 @@ void VctTechnique::light_dense() {
     Stopwatch watch;
     DenseMipTexture::clear_level0(t.direct);
     std::vector<VoxelRadiance> values(list.size());  // full precision, for the bounce
-    parallel_for(list.size(), 16, [&](size_t b, size_t e) {
+    parallel_blocks(list.size(), kInjectionBlock, [&](size_t b, size_t e) {
         uint64_t local = 0;
+        shading.direct(e - b, 0, voxel, [&](size_t i) { return std::pair(input_of(list[b + i], t.lattice()), list[b + i].coord); },
+                       values.data() + b, local);
         for (size_t i = b; i < e; ++i) {
-            values[i] = shading.direct(input_of(list[i], t.lattice()), 0, list[i].coord, voxel, local);
             const size_t first = t.index(0, 0, list[i].coord);
             for (int f = 0; f < kFaceCount; ++f) t.direct[0][first + size_t(f)] = to_half_rgba(values[i][size_t(f)]);
         }
