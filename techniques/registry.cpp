@@ -5,6 +5,7 @@
 #include "core/util/error.hpp"
 #include "techniques/dag_raycast/dag_raycast_technique.hpp"
 #include "techniques/dag_shadows/dag_shadows_technique.hpp"
+#include "techniques/lpv/lpv_technique.hpp"
 #include "techniques/path_tracer/path_tracer.hpp"
 #include "techniques/photon_mapping/photon_technique.hpp"
 #include "techniques/vct/vct_technique.hpp"
@@ -65,6 +66,7 @@ const TechniqueRegistry& TechniqueRegistry::builtin() {
         register_vct(r);
         register_dag_shadows(r);
         register_dag_raycast(r);
+        register_lpv(r);
         return r;
     }();
     return registry;
