@@ -39,9 +39,11 @@ public:
     // For the face between light cells c − e and c along `axis` (e: the unit step;
     // c[axis] in [0, resolution], the volume's border faces included), light crossing it
     // along +e (sign > 0) or −e: the transmittance towards each of the 5 faces of
-    // propagation_stencil's neighbour (axis, sign), in its order. Filled by update_faces.
+    // propagation_stencil's neighbour (axis, sign), in its order; nullptr when all five
+    // are 1 (nothing blocks: most faces). Filled by update_faces.
     const float* face_transmittance(int axis, int sign, const IVec3& c) const {
-        return faces_[size_t(axis)][face_index(axis, c)].t[sign > 0 ? 0 : 1].data();
+        const size_t i = face_index(c), s = sign > 0 ? 0 : 1;
+        return (open_[size_t(axis)][i] >> s) & 1 ? nullptr : faces_[size_t(axis)][i][s].data();
     }
     void update_faces();
     const std::vector<Sh4>& blocking() const { return blocking_; }
@@ -53,15 +55,16 @@ private:
         const size_t n = size_t(corners());
         return (size_t(c.z) * n + size_t(c.y)) * n + size_t(c.x);
     }
-    size_t face_index(int axis, const IVec3& c) const;
+    // Faces of every axis are indexed like the corners, (z, y, x) over (resolution + 1)³,
+    // so the gather, walking cells in x, reads them in order.
+    size_t face_index(const IVec3& c) const { return corner_index(c); }
     void add(const Surfel& s);
 
     LpvLattice lattice_;
     std::vector<Sh4> blocking_;                 // (resolution + 1)³
-    struct FaceTransmittance {
-        std::array<std::array<float, 5>, 2> t;  // [+e, −e][stencil face]
-    };
-    std::array<std::vector<FaceTransmittance>, 3> faces_;  // per axis: (resolution + 1)·resolution²
+    using FaceTransmittance = std::array<std::array<float, 5>, 2>;  // [+e, −e][stencil face]
+    std::array<std::vector<FaceTransmittance>, 3> faces_;  // per axis
+    std::array<std::vector<uint8_t>, 3> open_;             // per axis: bit s set when all of faces_[…][s] are 1
 };
 
 // Fraction of light crossing a face in direction w that gets through.

@@ -45,10 +45,18 @@ namespace {
 // channel, added to the destination as clamped-cosine lobes around the face normals.
 // The lobes share their constant term and differ in the linear term only, so the sum is
 // c₀·Σw in coefficient 0 and c₁·Σ w·normal in the others.
-// `transmit`: the 5 faces' transmittances, null for none.
+// `transmit`: the 5 faces' transmittances, null when nothing blocks (then the
+// neighbour's transfer matrix does the same in fewer operations).
 inline void send(const ShRgb& source, const StencilNeighbour& nb, const float* transmit, ShRgb& to) {
-    static constexpr float kOpen[5] = {1, 1, 1, 1, 1};
-    const float* t = transmit ? transmit : kOpen;
+    if (!transmit) {
+        for (size_t ch = 0; ch < 3; ++ch)
+            for (size_t i = 0; i < 4; ++i) {
+                const float s = source[ch][i];
+                for (size_t j = 0; j < 4; ++j) to[ch][j] += s * nb.transfer[i][j];
+            }
+        return;
+    }
+    const float* t = transmit;
     for (size_t ch = 0; ch < 3; ++ch) {
         float total = 0;
         Vec3 linear(0);

@@ -60,6 +60,9 @@ const std::array<StencilNeighbour, 6>& propagation_stencil() {
                         nb.faces[size_t(f++)] = make_face(main + 0.5f * to_side, side, to_side);
                     }
                 }
+                for (const StencilFace& face : nb.faces)
+                    for (size_t j = 0; j < 4; ++j)
+                        for (size_t i = 0; i < 4; ++i) nb.transfer[i][j] += face.lobe[j] * face.gather[i];
             }
         return s;
     }();
