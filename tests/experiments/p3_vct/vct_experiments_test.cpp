@@ -82,7 +82,10 @@ TEST_F(VctExperiments, MemoryChargesEachStructureItsRealEncodingInMegabytesOfTen
             ++checked;
         } else if (structure == "cascaded") {
             const double levels = std::log2(n / 32.0) + 1;  // 32³ per level, finest voxel = the grid's
-            EXPECT_DOUBLE_EQ(memory, levels * 32 * 32 * 32 * 6 * 4 / 1e6);  // a float per face
+            // A 32-bit G-buffer slot per cell, and a float per face of the occupied voxels
+            // only: more than the slots, less than a slot and six floats per cell.
+            EXPECT_GT(memory, levels * 32 * 32 * 32 * 4 / 1e6) << row.dump();
+            EXPECT_LT(memory, levels * 32 * 32 * 32 * (4 + 6 * 4) / 1e6) << row.dump();
             ++checked;
         } else if (structure == "SVO") {
             // A mask byte per node, a 4-byte index per node with children: more than 1 B
@@ -157,7 +160,7 @@ TEST_F(VctExperiments, SibenikStandsBesideSponzaAndTheWalkHasThePhotonCurve) {
         variants[row.at("scene")].insert(row.at("variant"));
     }
     const std::set<std::string> expected = {"dense mip", "cascaded, update everything", "cascaded, update strategy",
-                                            "photon mapping"};
+                                            "photon mapping", "LPV"};
     EXPECT_EQ(variants["sponza"], expected);
     if (sibenik) {
         EXPECT_EQ(variants["sibenik"], expected);
@@ -168,7 +171,7 @@ TEST_F(VctExperiments, SibenikStandsBesideSponzaAndTheWalkHasThePhotonCurve) {
     for (const ExperimentOutput* out : {&fig9, &fig10}) {
         EXPECT_EQ(out->plots.size(), variants.size());
         for (const auto& [name, plot] : out->plots) {
-            ASSERT_EQ(plot.series.size(), 4u) << name;
+            ASSERT_EQ(plot.series.size(), 5u) << name;
             for (const auto& series : plot.series) {
                 EXPECT_EQ(series.x.size(), fig9.tables.at(0).rows.size()) << name << " " << series.label;
                 EXPECT_EQ(variants.begin()->second.count(series.label), 1u) << series.label;
@@ -298,12 +301,12 @@ TEST_F(VctExperiments, APartialMergeOfTheWalksLeavesTheMissingCellsEmpty) {
             }
             ++rows;
         }
-        EXPECT_EQ(rows, fig9 ? 5 : 4);
+        EXPECT_EQ(rows, fig9 ? 6 : 5);
         bool incomplete = false, absent = false;
         for (const std::string& note : out.notes) {
-            incomplete |= note.starts_with("Incomplete: 7 of 8 tasks have not run");
+            incomplete |= note.starts_with("Incomplete: 9 of 10 tasks have not run");
             absent |= note.starts_with("sponza: no walk for 'dense mip', 'cascaded, update everything', "
-                                       "'cascaded, update strategy' (task not merged)");
+                                       "'cascaded, update strategy', 'LPV' (task not merged)");
         }
         EXPECT_TRUE(incomplete);
         EXPECT_TRUE(absent);

@@ -251,6 +251,7 @@ void add_p3(std::map<std::string, Expected>& e) {
                      {"cascaded with update strategy", "fastest; update ≈ 2.0 ms vs VXGI 15.5 ms"},
                      {"cascaded without update strategy", "slightly faster than VXGI"},
                      {"PM", "PM (and LPV) 5–20 fps"},
+                     {"LPV", "PM (and LPV) 5–20 fps"},
                      {"update time VXGI / cascaded", "15.5 / 2.0 = 7.8 (VXGI vs cascaded)"}}};
     e["p3/fig10"] = {{"curve", "memory over VXGI"}, {"curve"}, {{"VXGI", 1.0}, {"cascaded", 0.4}}};
 }
