@@ -188,7 +188,7 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     std::string equal_time_of = "total";
     compare->add_option("--equal-time", compare_request.equal_time_seconds,
-                        "seconds: scale each technique's quality setting (path spp, photon photons, vct diffuse_cones, lpv iterations) "
+                        "seconds: scale each technique's quality setting (path spp, photon photons, vct diffuse_cones, lpv rsm_size) "
                         "until the time of --equal-time-of is about this long");
     compare->add_option("--equal-time-of", equal_time_of,
                         "what --equal-time equalises: total (prepare + one frame, the work that makes a still image) "

@@ -90,5 +90,6 @@ void register_phase_times(ExperimentRegistry& registry);       // vct-table7
 void register_camera_walks(ExperimentRegistry& registry);      // vct-fig9, vct-fig10
 void register_images(ExperimentRegistry& registry);            // vct-fig11, vct-fig12-13
 void register_stability(ExperimentRegistry& registry);         // vct-stability
+void register_equal_time(ExperimentRegistry& registry);        // vct-equal-time
 
 }  // namespace gilab::vct

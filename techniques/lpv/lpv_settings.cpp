@@ -18,10 +18,12 @@ const SettingsSchema& LpvSettings::schema() {
                  "farthest corner.");
         s.integer("rsm_size", d.rsm_size).range(1, 2048).unit("texels per side")
             .doc("Reflective shadow map size: per light (point lights: per cube face; emissive triangles: one map "
-                 "shared by all, sampled by power). Each texel that hits a surface is one VPL.");
+                 "shared by all, sampled by power). Each texel that hits a surface is one VPL.")
+            // The sampling density of the reflected light: more converges towards the
+            // one-bounce answer; iterations instead change how far light travels.
+            .quality_knob(4, 1024);
         s.integer("iterations", d.iterations).range(1, 256).unit("propagation steps")
-            .doc("Propagation iterations per cascade: how many cells light travels.")
-            .quality_knob(1, 64);
+            .doc("Propagation iterations per cascade: how many cells light travels.");
         s.boolean("occlusion", d.occlusion)
             .doc("Fuzzy occlusion by the geometry volume (surfels of the RSMs and the primary hits), from the second "
                  "iteration on.");

@@ -13,7 +13,7 @@ struct LpvSettings {
     int resolution = 32;       // cells per axis of every cascade, even
     double cell_size = 0;      // finest cascade's cell; 0: derived from the scene
     int rsm_size = 64;         // texels per side of every reflective shadow map
-    int iterations = 8;        // propagation steps per cascade (the quality knob)
+    int iterations = 8;        // propagation steps per cascade
     bool occlusion = true;     // fuzzy occlusion by the geometry volume
     float dampening = 0.5f;    // lookup moved this many cells along the normal
     int light_samples = 4;     // area-light samples of the ray-traced direct light

@@ -25,6 +25,8 @@ RUN_RATIOS = {
     "kd/nanoflann", "heap/no-heap", "split/fused", "cell_groups/off (both walking cells)",
     "paper/off (both walking tiles)", "right_over_left", "dense_over_cascaded", "cascaded_over_dense",
     "speedup_vs_paper_t_A (1 thread)", "speedup_vs_paper_t_A (all threads)",
+    # vct-equal-time: the quality each technique reaches in a time budget, and its errors.
+    "quality setting at equal time", "relMSE at equal time", "FLIP at equal time",
 }
 
 

@@ -40,7 +40,7 @@ TEST(LpvSettings, DefaultsAndClearErrors) {
     EXPECT_EQ(d.iterations, 8);
     EXPECT_TRUE(d.occlusion);
     ASSERT_NE(LpvSettings::schema().quality_knob(), nullptr);
-    EXPECT_EQ(LpvSettings::schema().quality_knob()->key, "iterations");
+    EXPECT_EQ(LpvSettings::schema().quality_knob()->key, "rsm_size");
     auto message = [](nlohmann::json j) {
         return test::error_of([&] { LpvSettings::from(Settings(j, "cfg")); });
     };
