@@ -45,6 +45,12 @@ public:
         const size_t i = face_index(c), s = sign > 0 ? 0 : 1;
         return (open_[size_t(axis)][i] >> s) & 1 ? nullptr : faces_[size_t(axis)][i][s].data();
     }
+    // The same for a row of faces: those at (x, y, z) for x = 0 … resolution, of `axis`
+    // and direction s (0: +e, 1: −e); open_row's bit s says "all five are 1".
+    const uint8_t* open_row(int axis, int y, int z) const { return open_[size_t(axis)].data() + corner_index(IVec3(0, y, z)); }
+    const std::array<std::array<float, 5>, 2>* face_row(int axis, int y, int z) const {
+        return faces_[size_t(axis)].data() + corner_index(IVec3(0, y, z));
+    }
     void update_faces();
     const std::vector<Sh4>& blocking() const { return blocking_; }
     Sh4& at(const IVec3& corner) { return blocking_[corner_index(corner)]; }

@@ -4,6 +4,9 @@
 #include <cmath>
 #include "accel/lpv/propagation_stencil.hpp"
 #include "core/util/parallel.hpp"
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace gilab {
 
@@ -49,11 +52,26 @@ namespace {
 // neighbour's transfer matrix does the same in fewer operations).
 inline void send(const ShRgb& source, const StencilNeighbour& nb, const float* transmit, ShRgb& to) {
     if (!transmit) {
+#if defined(__SSE2__)
+        // The four destination coefficients of a channel in one register.
+        const __m128 m0 = _mm_loadu_ps(nb.transfer[0].data()), m1 = _mm_loadu_ps(nb.transfer[1].data()),
+                     m2 = _mm_loadu_ps(nb.transfer[2].data()), m3 = _mm_loadu_ps(nb.transfer[3].data());
+        for (size_t ch = 0; ch < 3; ++ch) {
+            const float* s = source[ch].data();
+            __m128 acc = _mm_loadu_ps(to[ch].data());
+            acc = _mm_add_ps(acc, _mm_mul_ps(_mm_set1_ps(s[0]), m0));
+            acc = _mm_add_ps(acc, _mm_mul_ps(_mm_set1_ps(s[1]), m1));
+            acc = _mm_add_ps(acc, _mm_mul_ps(_mm_set1_ps(s[2]), m2));
+            acc = _mm_add_ps(acc, _mm_mul_ps(_mm_set1_ps(s[3]), m3));
+            _mm_storeu_ps(to[ch].data(), acc);
+        }
+#else
         for (size_t ch = 0; ch < 3; ++ch)
             for (size_t i = 0; i < 4; ++i) {
                 const float s = source[ch][i];
                 for (size_t j = 0; j < 4; ++j) to[ch][j] += s * nb.transfer[i][j];
             }
+#endif
         return;
     }
     const float* t = transmit;
@@ -85,35 +103,57 @@ DVec3 LightPropagationVolume::gather(const std::vector<ShRgb>& from, std::vector
     const int r = lattice_.resolution;
     const auto& stencil = propagation_stencil();
     std::vector<DVec3> left_per_slice(size_t(r), DVec3(0));
+    // Which sources hold light, decided once per cell rather than once per neighbour.
+    std::vector<uint8_t> lit(from.size());
+    parallel_for(from.size(), 4096, [&](size_t b, size_t e) {
+        for (size_t i = b; i < e; ++i) lit[i] = !is_dark(from[i]);
+    });
+    // Row by row: for each neighbour direction, the whole source row (shifted by the
+    // neighbour's offset) goes into the destination row, so both are read in order.
     parallel_for(size_t(r), 1, [&](size_t begin, size_t end) {
-        for (size_t z = begin; z < end; ++z)
-            for (int y = 0; y < r; ++y)
-                for (int x = 0; x < r; ++x) {
-                    const IVec3 c(x, y, int(z));
-                    ShRgb sum{};
-                    for (const StencilNeighbour& nb : stencil) {
-                        const IVec3 src = c - nb.offset;
-                        if (!lattice_.inside(src)) continue;
-                        const ShRgb& s = from[lattice_.index(src)];
-                        if (is_dark(s)) continue;
-                        // Occlusion at the face shared by source and destination, where
-                        // the light enters.
-                        const float* t = occlusion ? geometry_.face_transmittance(nb.axis, nb.sign, nb.sign > 0 ? c : src) : nullptr;
-                        send(s, nb, t, sum);
+        for (int z = int(begin); z < int(end); ++z)
+            for (int y = 0; y < r; ++y) {
+                ShRgb* out = to.data() + lattice_.index(IVec3(0, y, z));
+                std::fill(out, out + r, ShRgb{});
+                for (const StencilNeighbour& nb : stencil) {
+                    const IVec3 o = nb.offset;
+                    const int sy = y - o.y, sz = z - o.z;
+                    if (sy < 0 || sz < 0 || sy >= r || sz >= r) continue;
+                    const size_t src_first = lattice_.index(IVec3(0, sy, sz));
+                    const ShRgb* src = from.data() + src_first;
+                    const uint8_t* src_lit = lit.data() + src_first;
+                    // The shared face, where the light enters: at the destination for a
+                    // positive step, at the source for a negative one.
+                    const int fy = nb.sign > 0 ? y : sy, fz = nb.sign > 0 ? z : sz;
+                    const uint8_t* open = occlusion ? geometry_.open_row(nb.axis, fy, fz) : nullptr;
+                    const auto* faces = occlusion ? geometry_.face_row(nb.axis, fy, fz) : nullptr;
+                    const size_t s = nb.sign > 0 ? 0 : 1;
+                    const int x0 = std::max(0, o.x), x1 = std::min(r, r + o.x);
+                    for (int x = x0; x < x1; ++x) {
+                        const int sx = x - o.x;
+                        if (!src_lit[sx]) continue;
+                        const int fx = nb.sign > 0 ? x : sx;
+                        const float* t = open && !((open[fx] >> s) & 1) ? faces[fx][s].data() : nullptr;
+                        send(src[sx], nb, t, out[x]);
                     }
-                    to[lattice_.index(c)] = sum;
-                    // What this cell sends across the volume's border is lost.
-                    const bool border = x == 0 || y == 0 || z == 0 || x == r - 1 || y == r - 1 || int(z) == r - 1;
-                    if (!border) continue;
+                }
+                // What a border cell sends across the volume's border is lost.
+                const bool border_row = y == 0 || z == 0 || y == r - 1 || z == r - 1;
+                for (int x = 0; x < r; ++x) {
+                    if (!border_row && x != 0 && x != r - 1) continue;
+                    const IVec3 c(x, y, z);
+                    const ShRgb& source = from[lattice_.index(c)];
+                    if (is_dark(source)) continue;
                     for (const StencilNeighbour& nb : stencil) {
                         const IVec3 dst = c + nb.offset;
                         if (lattice_.inside(dst)) continue;
                         const float* t = occlusion ? geometry_.face_transmittance(nb.axis, nb.sign, nb.sign > 0 ? dst : c) : nullptr;
                         ShRgb lost{};
-                        send(from[lattice_.index(c)], nb, t, lost);
-                        for (size_t ch = 0; ch < 3; ++ch) left_per_slice[z][int(ch)] += double(sh_integral(lost[ch]));
+                        send(source, nb, t, lost);
+                        for (size_t ch = 0; ch < 3; ++ch) left_per_slice[size_t(z)][int(ch)] += double(sh_integral(lost[ch]));
                     }
                 }
+            }
     });
     DVec3 left(0);
     for (const DVec3& l : left_per_slice) left += l;  // fixed order
