@@ -21,28 +21,46 @@ struct TexelRay {
     float plane_area = 0;    // orthographic texels: area = texel area/cos
 };
 
-// Any map: size² texels, each mapped to its ray by `texel`.
+// Any map: size² texels, each mapped to its ray by `texel`. A row's rays go to Embree as
+// one coherent stream (they leave one light side by side); rows are fixed, so nothing
+// depends on the thread count.
 template <class TexelFn>
 void trace_map(const TracedScene& scene, int size, TexelFn&& texel, ReflectiveShadowMap& out) {
     const size_t n = size_t(size) * size_t(size);
     std::vector<std::optional<VirtualPointLight>> vpl(n);
     std::vector<Surfel> surfel(n);
     parallel_for(size_t(size), 1, [&](size_t begin, size_t end) {
-        for (size_t row = begin; row < end; ++row)
+        std::vector<TexelRay> texels;
+        std::vector<Ray> rays;
+        std::vector<size_t> index;
+        std::vector<Hit> hits;
+        for (size_t row = begin; row < end; ++row) {
+            texels.clear();
+            rays.clear();
+            index.clear();
             for (int col = 0; col < size; ++col) {
                 const size_t i = row * size_t(size) + size_t(col);
                 const std::optional<TexelRay> tr = texel(col, int(row), i);
                 if (!tr || max_component(tr->flux) <= 0.0f) continue;
-                const Hit hit = scene.tracer().intersect(tr->ray);
-                if (!hit.valid()) continue;
-                const SurfaceInteraction si = make_interaction(scene.frame(), tr->ray, hit);
-                const Material& m = scene.materials()[si.material];
-                const float t = hit.t * glm::length(tr->ray.direction);
-                const float cos_hit = std::max(0.05f, std::abs(glm::dot(si.geometric_normal, glm::normalize(tr->ray.direction))));
-                const float area = tr->plane_area > 0 ? tr->plane_area / cos_hit : tr->solid_angle * t * t / cos_hit;
-                vpl[i] = VirtualPointLight{si.position, si.shading_normal, m.albedo * tr->flux};
-                surfel[i] = Surfel{si.position, si.geometric_normal, area};
+                texels.push_back(*tr);
+                rays.push_back(tr->ray);
+                index.push_back(i);
             }
+            hits.resize(rays.size());
+            scene.tracer().intersect(rays, hits);
+            for (size_t k = 0; k < rays.size(); ++k) {
+                const Hit& hit = hits[k];
+                if (!hit.valid()) continue;
+                const TexelRay& tr = texels[k];
+                const SurfaceInteraction si = make_interaction(scene.frame(), tr.ray, hit);
+                const Material& m = scene.materials()[si.material];
+                const float t = hit.t * glm::length(tr.ray.direction);
+                const float cos_hit = std::max(0.05f, std::abs(glm::dot(si.geometric_normal, glm::normalize(tr.ray.direction))));
+                const float area = tr.plane_area > 0 ? tr.plane_area / cos_hit : tr.solid_angle * t * t / cos_hit;
+                vpl[index[k]] = VirtualPointLight{si.position, si.shading_normal, m.albedo * tr.flux};
+                surfel[index[k]] = Surfel{si.position, si.geometric_normal, area};
+            }
+        }
     });
     out.texels += n;
     for (size_t i = 0; i < n; ++i) {
