@@ -223,15 +223,19 @@ std::vector<VoxelBox> CascadedVoxelTexture::scroll(int level, const IVec3& new_o
 void CascadedVoxelTexture::write(int level, const AnisotropicVoxel& voxel) {
     if (!contains(level, voxel.coord))
         throw Error("cascaded voxel texture", "voxel outside level " + std::to_string(level) + "'s region");
+    store(level, pack_voxel(voxel, lattice(level)));
+}
+
+void CascadedVoxelTexture::store(int level, const PackedVoxel& voxel) {
     gbuffer_clear_[size_t(level)] = false;
     std::vector<PackedVoxel>& pool = pools_[size_t(level)];
     uint32_t& slot = slots_[slot_index(level, voxel.coord)];
     if (slot == kEmptySlot) {
         if (pool.size() >= kEmptySlot) throw Error("cascaded voxel texture", "G-buffer pool full");
         slot = uint32_t(pool.size());
-        pool.push_back(pack_voxel(voxel, lattice(level)));
+        pool.push_back(voxel);
     } else {
-        pool[slot] = pack_voxel(voxel, lattice(level));
+        pool[slot] = voxel;
     }
 }
 
@@ -252,9 +256,11 @@ FragmentVoxelizeStats CascadedVoxelTexture::voxelize_boxes(int level, const Frag
                                                            const VoxelBox& exclude) {
     FragmentVoxelizeStats stats;
     std::mutex pool_lock;  // the voxelizer emits from worker threads; the pool grows one at a time
-    voxelizer.voxelize_each(lattice(level), boxes, [&](const AnisotropicVoxel& v) {
+    const VoxelLattice on = lattice(level);
+    voxelizer.voxelize_each(on, boxes, [&](const AnisotropicVoxel& v) {
+        const PackedVoxel packed = pack_voxel(v, on);  // outside the lock
         const std::lock_guard<std::mutex> hold(pool_lock);
-        write(level, v);
+        store(level, packed);
     }, &stats, exclude);
     compact_if_sparse(level);
     return stats;

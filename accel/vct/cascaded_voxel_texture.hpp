@@ -166,6 +166,7 @@ private:
     FragmentVoxelizeStats voxelize_boxes(int level, const FragmentVoxelizer& voxelizer,
                                          const std::vector<VoxelBox>& boxes, const VoxelBox& exclude);
     void compact_if_sparse(int level);
+    void store(int level, const PackedVoxel& voxel);  // voxel.coord inside the region
     CascadeConfig config_;
     std::vector<IVec3> origins_;
     std::vector<VoxelBox> own_inner_;  // inner box excluded by the last voxelize_own / follow_inner
