@@ -33,7 +33,7 @@
 #include "techniques/lpv/lpv_settings.hpp"
 #include "techniques/lpv/reflective_shadow_maps.hpp"
 #include "techniques/technique.hpp"
-#include "techniques/vct/direct_lighting.hpp"
+#include "core/render/direct_lighting.hpp"
 
 namespace gilab {
 

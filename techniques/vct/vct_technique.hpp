@@ -43,7 +43,7 @@
 #include "core/render/traced_scene.hpp"
 #include "techniques/technique.hpp"
 #include "techniques/vct/cone_tracer.hpp"
-#include "techniques/vct/direct_lighting.hpp"
+#include "core/render/direct_lighting.hpp"
 
 namespace gilab {
 

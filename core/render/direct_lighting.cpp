@@ -1,4 +1,4 @@
-#include "techniques/vct/direct_lighting.hpp"
+#include "core/render/direct_lighting.hpp"
 
 #include <cmath>
 #include "core/render/bsdf.hpp"
