@@ -79,38 +79,26 @@ void LpvTechnique::update(double time) {
     stats_.set("scene_update_ms", watch.elapsed_ms());
 }
 
-void LpvTechnique::trace_primary(const EyeCamera& camera, std::vector<PixelHit>& hits, std::vector<Surfel>& surfels) const {
-    const int width = camera.width(), height = camera.height();
-    hits.assign(size_t(width) * size_t(height), PixelHit{});
+std::vector<Surfel> LpvTechnique::camera_surfels(const EyeCamera& camera, const std::vector<PixelHit>& hits) {
+    const size_t width = size_t(camera.width());
     std::vector<float> area(hits.size(), 0.0f);
-    parallel_for_tiles(width, height, settings_.tile_size, [&](const Tile& tile) {
-        for (int y = tile.y0; y < tile.y1; ++y)
-            for (int x = tile.x0; x < tile.x1; ++x) {
-                const Ray ray = camera.generate_ray(float(x) + 0.5f, float(y) + 0.5f);
-                const Hit hit = scene_.tracer().intersect(ray);
-                const size_t i = size_t(y) * size_t(width) + size_t(x);
-                PixelHit& ph = hits[i];
-                if (!hit.valid()) continue;
-                const SurfaceInteraction si = make_interaction(scene_.frame(), ray, hit);
-                ph.hit = true;
-                ph.position = si.position;
-                ph.normal = si.shading_normal;
-                ph.geometric_normal = si.geometric_normal;
-                ph.wo = si.wo;
-                ph.material = si.material;
-                ph.depth = hit.t * glm::length(ray.direction);
-                ph.emissive_front = scene_.materials()[si.material].is_emissive() && !si.back_face;
-                // The pixel's footprint on the surface: its solid angle · depth² / cos.
-                const Vec3 d0 = glm::normalize(ray.direction);
-                const Vec3 dx = glm::normalize(camera.generate_ray(float(x) + 1.5f, float(y) + 0.5f).direction) - d0;
-                const Vec3 dy = glm::normalize(camera.generate_ray(float(x) + 0.5f, float(y) + 1.5f).direction) - d0;
-                const float cos_hit = std::max(0.05f, glm::dot(si.geometric_normal, si.wo));
-                area[i] = glm::length(glm::cross(dx, dy)) * ph.depth * ph.depth / cos_hit;
-            }
+    parallel_for(hits.size(), 1024, [&](size_t begin, size_t end) {
+        for (size_t i = begin; i < end; ++i) {
+            const PixelHit& ph = hits[i];
+            if (!ph.hit) continue;
+            // The pixel's footprint on the surface: its solid angle · depth² / cos.
+            const float x = float(i % width), y = float(i / width);
+            const Vec3 d0 = glm::normalize(camera.generate_ray(x + 0.5f, y + 0.5f).direction);
+            const Vec3 dx = glm::normalize(camera.generate_ray(x + 1.5f, y + 0.5f).direction) - d0;
+            const Vec3 dy = glm::normalize(camera.generate_ray(x + 0.5f, y + 1.5f).direction) - d0;
+            const float cos_hit = std::max(0.05f, glm::dot(ph.geometric_normal, ph.wo));
+            area[i] = glm::length(glm::cross(dx, dy)) * ph.depth * ph.depth / cos_hit;
+        }
     });
-    surfels.clear();
+    std::vector<Surfel> surfels;
     for (size_t i = 0; i < hits.size(); ++i)
         if (hits[i].hit) surfels.push_back(Surfel{hits[i].position, hits[i].geometric_normal, area[i]});
+    return surfels;
 }
 
 void LpvTechnique::update_volumes(const Vec3& viewer, const std::vector<std::vector<Surfel>>& camera_surfels) {
@@ -181,14 +169,15 @@ void LpvTechnique::render(const ViewSet& views, std::vector<Film>& films) {
 
     Stopwatch watch;
     std::vector<std::vector<PixelHit>> hits(views.views.size());
-    std::vector<std::vector<Surfel>> camera_surfels(views.views.size());
+    std::vector<std::vector<Surfel>> surfels(views.views.size());
     for (size_t vi = 0; vi < views.views.size(); ++vi) {
         check_resolution(views.views[vi].width(), views.views[vi].height(), 6);
-        trace_primary(views.views[vi], hits[vi], camera_surfels[vi]);
+        hits[vi] = trace_visible_surfaces(scene_, views.views[vi], settings_.tile_size);
+        surfels[vi] = camera_surfels(views.views[vi], hits[vi]);
     }
     const double primary_ms = watch.elapsed_ms();
 
-    update_volumes(viewer, settings_.occlusion ? camera_surfels : std::vector<std::vector<Surfel>>{});
+    update_volumes(viewer, settings_.occlusion ? surfels : std::vector<std::vector<Surfel>>{});
 
     double direct_ms = 0, lookup_ms = 0;
     films.resize(views.views.size());
@@ -201,31 +190,12 @@ void LpvTechnique::render(const ViewSet& views, std::vector<Film>& films) {
         const std::vector<PixelHit>& view_hits = hits[vi];
         Layer& direct = film.layer("direct");
         Layer& indirect = film.layer("indirect");
-        Layer& albedo = film.layer("albedo");
-        Layer& normal = film.layer("normal");
-        Layer& depth = film.layer("depth");
         auto put = [](Layer& l, size_t i, const Vec3& v) {
             for (int k = 0; k < 3; ++k) l.data[3 * i + size_t(k)] = v[k];
         };
 
         watch.reset();
-        parallel_for_tiles(width, height, settings_.tile_size, [&](const Tile& tile) {
-            for (int y = tile.y0; y < tile.y1; ++y)
-                for (int x = tile.x0; x < tile.x1; ++x) {
-                    const size_t i = size_t(y) * size_t(width) + size_t(x);
-                    const PixelHit& ph = view_hits[i];
-                    if (!ph.hit) continue;
-                    const Material& m = scene_.materials()[ph.material];
-                    Rng rng = Rng::for_sample(settings_.seed, i, 0, vi);
-                    Vec3 L = lighting_.reflected(scene_.tracer(), m, ph.position, ph.normal, ph.geometric_normal, ph.wo,
-                                                 4.0f * ray_epsilon(ph.position), rng);
-                    if (ph.emissive_front) L += m.emission;
-                    put(direct, i, L);
-                    put(albedo, i, m.albedo + m.specular);
-                    put(normal, i, ph.normal);
-                    depth.data[i] = ph.depth;
-                }
-        });
+        shade_direct_light(scene_, lighting_, view_hits, settings_.seed, vi, settings_.tile_size, film);
         direct_ms += watch.elapsed_ms();
 
         watch.reset();

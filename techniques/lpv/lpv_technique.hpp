@@ -34,6 +34,7 @@
 #include "techniques/lpv/reflective_shadow_maps.hpp"
 #include "techniques/technique.hpp"
 #include "core/render/direct_lighting.hpp"
+#include "core/render/visible_surfaces.hpp"
 
 namespace gilab {
 
@@ -49,16 +50,10 @@ public:
     const LpvCascades& cascades() const { return *cascades_; }
 
 private:
-    struct PixelHit {
-        bool hit = false;
-        bool emissive_front = false;
-        Vec3 position{0}, normal{0}, geometric_normal{0}, wo{0};
-        uint32_t material = 0;
-        float depth = 0;
-    };
     // Steps 2–4 for a viewer position and the views' surfels.
     void update_volumes(const Vec3& viewer, const std::vector<std::vector<Surfel>>& camera_surfels);
-    void trace_primary(const EyeCamera& camera, std::vector<PixelHit>& hits, std::vector<Surfel>& surfels) const;
+    // The surfels of a view's hits for the geometry volume: each pixel's footprint on its surface.
+    static std::vector<Surfel> camera_surfels(const EyeCamera& camera, const std::vector<PixelHit>& hits);
     size_t structure_bytes() const;
 
     LpvSettings settings_;

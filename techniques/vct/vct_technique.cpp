@@ -6,6 +6,7 @@
 #include "core/util/error.hpp"
 #include "core/util/format.hpp"
 #include "core/render/interaction.hpp"
+#include "core/render/visible_surfaces.hpp"
 #include "core/util/parallel.hpp"
 #include "core/util/progress.hpp"
 #include "core/util/rng.hpp"
@@ -674,18 +675,6 @@ void VctTechnique::update_voxels(const Vec3& viewer) {
 
 // ---------------------------------------------------------------------------------
 
-namespace {
-
-struct PixelHit {
-    bool hit = false;
-    bool emissive_front = false;
-    Vec3 position{0}, normal{0}, geometric_normal{0}, wo{0};
-    uint32_t material = 0;
-    float depth = 0;
-};
-
-}  // namespace
-
 void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
     if (!scene_.loaded()) throw Error("vct", "render() called before prepare()");
     if (views.views.empty()) throw Error("vct", "render() needs at least one view");
@@ -739,61 +728,24 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
         film.add_layer("ao", 1);
         film.add_layer("depth", 1);
         const size_t pixels = film.pixel_count();
-        std::vector<PixelHit> hits(pixels);
         const int ts = settings_.tile_size;
 
         Stopwatch watch;
-        parallel_for_tiles(width, height, ts, [&](const Tile& tile) {
-            for (int y = tile.y0; y < tile.y1; ++y)
-                for (int x = tile.x0; x < tile.x1; ++x) {
-                    Ray ray = camera.generate_ray(float(x) + 0.5f, float(y) + 0.5f);
-                    Hit hit = scene_.tracer().intersect(ray);
-                    PixelHit& ph = hits[size_t(y) * size_t(width) + size_t(x)];
-                    if (!hit.valid()) continue;
-                    SurfaceInteraction si = make_interaction(scene_.frame(), ray, hit);
-                    ph.hit = true;
-                    ph.position = si.position;
-                    ph.normal = si.shading_normal;
-                    ph.geometric_normal = si.geometric_normal;
-                    ph.wo = si.wo;
-                    ph.material = si.material;
-                    ph.depth = hit.t * glm::length(ray.direction);
-                    ph.emissive_front = scene_.materials()[si.material].is_emissive() && !si.back_face;
-                }
-        });
+        const std::vector<PixelHit> hits = trace_visible_surfaces(scene_, camera, ts);
         primary_ms += watch.elapsed_ms();
 
         Layer& color = film.layer("color");
         Layer& direct = film.layer("direct");
         Layer& indirect = film.layer("indirect");
         Layer& specular = film.layer("specular");
-        Layer& albedo = film.layer("albedo");
-        Layer& normal = film.layer("normal");
         Layer& ao = film.layer("ao");
-        Layer& depth = film.layer("depth");
         auto put = [](Layer& l, size_t i, const Vec3& v) {
             for (int k = 0; k < 3; ++k) l.data[3 * i + size_t(k)] = v[k];
         };
 
         watch.reset();
-        parallel_for_tiles(width, height, ts, [&](const Tile& tile) {
-            for (int y = tile.y0; y < tile.y1; ++y)
-                for (int x = tile.x0; x < tile.x1; ++x) {
-                    const size_t i = size_t(y) * size_t(width) + size_t(x);
-                    const PixelHit& ph = hits[i];
-                    ao.data[i] = 1.0f;
-                    if (!ph.hit) continue;
-                    const Material& m = scene_.materials()[ph.material];
-                    Rng rng = Rng::for_sample(settings_.seed, i, 0, vi);
-                    Vec3 L = lighting_.reflected(scene_.tracer(), m, ph.position, ph.normal, ph.geometric_normal, ph.wo,
-                                                 4.0f * ray_epsilon(ph.position), rng);
-                    if (ph.emissive_front) L += m.emission;
-                    put(direct, i, L);
-                    put(albedo, i, m.albedo + m.specular);
-                    put(normal, i, ph.normal);
-                    depth.data[i] = ph.depth;
-                }
-        });
+        std::fill(ao.data.begin(), ao.data.end(), 1.0f);
+        shade_direct_light(scene_, lighting_, hits, settings_.seed, vi, ts, film);
         direct_ms += watch.elapsed_ms();
 
         watch.reset();
