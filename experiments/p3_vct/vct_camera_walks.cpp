@@ -38,21 +38,31 @@ ProbeOutput walk_probe(const ProbeCall& call, const std::function<WalkSeries(con
     return out;
 }
 
+// The stats a technique names its frame time, update, injection and structure bytes by.
+struct WalkStats {
+    const char *total, *update, *injection, *bytes;
+};
+
+// Technique `t` rendering every camera of the walk, its figures after each frame.
+WalkSeries walk_technique(Technique& t, const std::vector<EyeCamera>& cams, const WalkStats& keys) {
+    WalkSeries s;
+    for (const EyeCamera& cam : cams) {
+        render(t, cam);
+        const Stats st = t.stats();
+        s.total_ms.push_back(st.get(keys.total));
+        s.update_ms.push_back(st.get(keys.update));
+        s.injection_ms.push_back(st.get(keys.injection));
+        s.bytes.push_back(st.get(keys.bytes));
+        s.rss.push_back(double(current_rss_bytes()));
+    }
+    return s;
+}
+
 // A cone-traced variant (setting "vct", dense resolution from the axis) along the walk.
 ProbeOutput vct_walk_probe(const ProbeCall& call) {
     return walk_probe(call, [&](const Scene& scene, const std::vector<EyeCamera>& cams) {
-        WalkSeries s;
         auto t = make_vct(scene, vct_settings(call), call.ctx);
-        for (const EyeCamera& cam : cams) {
-            render(*t, cam);
-            const Stats st = t->stats();
-            s.total_ms.push_back(st.get("total_ms"));
-            s.update_ms.push_back(st.get("update_ms"));
-            s.injection_ms.push_back(st.get("injection_ms"));
-            s.bytes.push_back(st.get("structure_bytes"));
-            s.rss.push_back(double(current_rss_bytes()));
-        }
-        return s;
+        return walk_technique(*t, cams, {"total_ms", "update_ms", "injection_ms", "structure_bytes"});
     });
 }
 
@@ -85,20 +95,10 @@ ProbeOutput photon_walk_probe(const ProbeCall& call) {
 // cone tracers re-inject every frame.
 ProbeOutput lpv_walk_probe(const ProbeCall& call) {
     return walk_probe(call, [&](const Scene& scene, const std::vector<EyeCamera>& cams) {
-        WalkSeries s;
         nlohmann::json settings = call.setting<nlohmann::json>("lpv");
         settings["seed"] = call.ctx.seed;
         auto t = prepare_technique("lpv", scene, Settings(settings, call.spec.name + " lpv settings"));
-        for (const EyeCamera& cam : cams) {
-            render(*t, cam);
-            const Stats st = t->stats();
-            s.total_ms.push_back(st.get("total_ms"));
-            s.update_ms.push_back(st.get("lpv_ms"));
-            s.injection_ms.push_back(st.get("inject_ms"));
-            s.bytes.push_back(st.get("structure_bytes"));
-            s.rss.push_back(double(current_rss_bytes()));
-        }
-        return s;
+        return walk_technique(*t, cams, {"total_ms", "lpv_ms", "inject_ms", "structure_bytes"});
     });
 }
 

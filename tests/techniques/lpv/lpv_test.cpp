@@ -8,6 +8,7 @@
 #include "core/util/error.hpp"
 #include "core/util/parallel.hpp"
 #include "scenes/builtin_scenes.hpp"
+#include "tests/techniques/technique_test_support.hpp"
 #include "techniques/lpv/lpv_technique.hpp"
 #include "techniques/technique.hpp"
 #include "tests/test_support.hpp"
@@ -16,22 +17,10 @@ namespace gilab {
 namespace {
 
 std::unique_ptr<LpvTechnique> prepared(const Scene& scene, nlohmann::json settings_json) {
-    auto t = std::make_unique<LpvTechnique>();
-    prepare_technique(*t, scene, Settings(std::move(settings_json), "test settings"));
-    return t;
+    return test::prepared_technique<LpvTechnique>(scene, std::move(settings_json));
 }
-
-Film render_one(LpvTechnique& t, const EyeCamera& camera) {
-    std::vector<Film> films;
-    t.render(ViewSet::mono(camera), films);
-    EXPECT_EQ(films.size(), 1u);
-    return films.at(0);
-}
-
-// A viewer inside the box, so the box lies in the finer cascades.
-EyeCamera inside_camera(int size) {
-    return EyeCamera::look_at(Vec3(0.5f, 0.45f, 0.06f), Vec3(0.5f, 0.42f, 1.0f), Vec3(0, 1, 0), 75.0f, size, size);
-}
+using test::inside_camera;
+using test::render_one;
 
 TEST(LpvSettings, DefaultsAndClearErrors) {
     const LpvSettings d = LpvSettings::from(Settings());

@@ -13,6 +13,7 @@
 #include "core/util/parallel.hpp"
 #include "core/scene/skin.hpp"
 #include "scenes/builtin_scenes.hpp"
+#include "tests/techniques/technique_test_support.hpp"
 #include "techniques/technique.hpp"
 #include "techniques/vct/cone_tracer.hpp"
 #include "techniques/vct/vct_technique.hpp"
@@ -21,23 +22,10 @@ namespace gilab {
 namespace {
 
 std::unique_ptr<VctTechnique> prepared(const Scene& scene, nlohmann::json settings_json) {
-    auto t = std::make_unique<VctTechnique>();
-    prepare_technique(*t, scene, Settings(std::move(settings_json), "test settings"));
-    return t;
+    return test::prepared_technique<VctTechnique>(scene, std::move(settings_json));
 }
-
-Film render_one(VctTechnique& t, const EyeCamera& camera) {
-    std::vector<Film> films;
-    t.render(ViewSet::mono(camera), films);
-    EXPECT_EQ(films.size(), 1u);
-    return films.at(0);
-}
-
-// A viewer inside the box (the cascades centre on the viewer: seen from the usual
-// camera 1.4 units in front of the box, the box would fall in the coarsest levels).
-EyeCamera inside_camera(int size) {
-    return EyeCamera::look_at(Vec3(0.5f, 0.45f, 0.06f), Vec3(0.5f, 0.42f, 1.0f), Vec3(0, 1, 0), 75.0f, size, size);
-}
+using test::inside_camera;
+using test::render_one;
 
 // ---------------------------------------------------------------------------------
 
