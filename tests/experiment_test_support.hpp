@@ -75,11 +75,14 @@ inline ExperimentOutput run_quick_checked(const Experiment& experiment, const Ex
     return out;
 }
 
-inline ExperimentOutput run_quick_experiment(const ExperimentRegistry& registry, const std::string& name) {
+// `written`, when given, receives the folder the run wrote.
+inline ExperimentOutput run_quick_experiment(const ExperimentRegistry& registry, const std::string& name,
+                                             std::filesystem::path* written = nullptr) {
     namespace fs = std::filesystem;
     ExperimentContext ctx;
     ctx.quick = true;
     ctx.output_dir = temp_dir("quick_experiment_" + name);
+    if (written) *written = ctx.output_dir;
     ctx.assets = AssetPaths::from_environment();
     ExperimentOutput out = run_quick_checked(registry.get(name), ctx);
     for (const char* file : {"results.csv", "results.json", "table.md"})

@@ -52,18 +52,15 @@ TEST_P(VctQuickExperiment, RunsAndFillsEveryColumnWithoutTargets) {
 INSTANTIATE_TEST_SUITE_P(All, VctQuickExperiment,
                          testing::Values("vct-table1", "vct-table2", "vct-table3", "vct-table4", "vct-table5",
                                          "vct-table6", "vct-table7", "vct-fig9", "vct-fig10", "vct-fig11",
-                                         "vct-fig12-13", "vct-stability", "vct-equal-time"),
+                                         "vct-fig12-13", "vct-stability"),
                          test::test_name_of);
 
 // The equal-time study: every technique of each scene compared, its knob named, and the
 // images and heat maps it lists written.
 TEST_F(VctExperiments, EqualTimeStudyNamesEachKnobAndWritesItsHeatMaps) {
     namespace fs = std::filesystem;
-    ExperimentContext ctx;
-    ctx.quick = true;
-    ctx.assets = AssetPaths::from_environment();
-    ctx.output_dir = test::temp_dir("vct_equal_time");
-    const ExperimentOutput out = run_and_write(vct_registry().get("vct-equal-time"), ctx);
+    fs::path folder;
+    const ExperimentOutput out = test::run_quick_experiment(vct_registry(), "vct-equal-time", &folder);
     const std::map<std::string, std::string> knobs = {{"photon", "photons="}, {"vct", "diffuse_cones="}, {"lpv", "rsm_size="}};
     for (const json& row : out.tables.at(0).rows) {
         const std::string technique = row.at("technique");
@@ -71,15 +68,15 @@ TEST_F(VctExperiments, EqualTimeStudyNamesEachKnobAndWritesItsHeatMaps) {
         EXPECT_GT(row.at("relMSE at equal time").get<double>(), 0.0) << row.dump();
         EXPECT_GT(row.at("FLIP at equal time").get<double>(), 0.0) << row.dump();
         for (const char* suffix : {".png", "_flip.png"})
-            EXPECT_TRUE(fs::exists(ctx.output_dir / "equal_time" / "compare" / row.at("scene").get<std::string>() /
+            EXPECT_TRUE(fs::exists(folder / "equal_time" / "compare" / row.at("scene").get<std::string>() /
                                    (technique + suffix)))
                 << technique << suffix;
     }
-    std::ifstream results(ctx.output_dir / "results.json");
+    std::ifstream results(folder / "results.json");
     const json written = json::parse(results);
     size_t heat_maps = 0;
     for (const json& f : written.at("files")) {
-        EXPECT_TRUE(fs::exists(ctx.output_dir / f.get<std::string>())) << f;
+        EXPECT_TRUE(fs::exists(folder / f.get<std::string>())) << f;
         heat_maps += f.get<std::string>().ends_with("_flip.png");
     }
     EXPECT_EQ(heat_maps, out.tables.at(0).rows.size());
