@@ -173,11 +173,11 @@ void LpvTechnique::render(const ViewSet& views, std::vector<Film>& films) {
     for (size_t vi = 0; vi < views.views.size(); ++vi) {
         check_resolution(views.views[vi].width(), views.views[vi].height(), 6);
         hits[vi] = trace_visible_surfaces(scene_, views.views[vi], settings_.tile_size);
-        surfels[vi] = camera_surfels(views.views[vi], hits[vi]);
+        if (settings_.occlusion) surfels[vi] = camera_surfels(views.views[vi], hits[vi]);  // only occlusion reads them
     }
     const double primary_ms = watch.elapsed_ms();
 
-    update_volumes(viewer, settings_.occlusion ? surfels : std::vector<std::vector<Surfel>>{});
+    update_volumes(viewer, surfels);
 
     double direct_ms = 0, lookup_ms = 0;
     films.resize(views.views.size());
