@@ -308,7 +308,7 @@ const std::vector<SpecVariant> kWalkVariants = {
     {.name = "photon mapping", .probe = "photon-walk", .settings = {{"photon", {{"photons", 256 * 256}, {"radius", 0.5}}}}},
     // Kaplanyan & Dachsbacher's defaults (lpv's): 3 cascades of 32³, 8 iterations.
     {.name = "LPV", .probe = "lpv-walk", .settings = {{"lpv", nlohmann::json::object()}}}};
-const SpecAxis kDenseResolution = {"dense_resolution", {128}, {64}};
+const SpecAxis kDenseResolution = {"dense_resolution", {128}, {32}};
 
 std::string walk_note() {
     std::string note = "Camera walks, straight down each nave, looking ahead and slightly up, 60° field of view: ";
@@ -331,7 +331,7 @@ void register_camera_walks(ExperimentRegistry& registry) {
         .description = "frame time along walks through Sponza and Sibenik: dense, cascaded without/with the update strategy, photon mapping, LPV",
         .scenes = kWalkScenes,
         .size = 192, .quick_size = 32,
-        .frames = 30, .quick_frames = 4,
+        .frames = 30, .quick_frames = 2,
         .variants = kWalkVariants,
         .axes = {kDenseResolution},
         .reducer = "vct-fig9",
@@ -351,7 +351,7 @@ void register_camera_walks(ExperimentRegistry& registry) {
         .description = "structure memory along the walks through Sponza and Sibenik",
         .scenes = kWalkScenes,
         .size = 192, .quick_size = 32,
-        .frames = 30, .quick_frames = 4,
+        .frames = 30, .quick_frames = 2,
         .variants = kWalkVariants,
         .axes = {kDenseResolution},
         .reducer = "vct-fig10",

@@ -36,13 +36,15 @@ TEST_P(PhotonQuickExperiment, RunsAndFillsEveryColumn) {
 }
 
 INSTANTIATE_TEST_SUITE_P(All, PhotonQuickExperiment,
-                         testing::Values("pm-fig8", "pm-table5", "pm-final", "pm-foveated"), test::test_name_of);
+                         testing::Values("pm-fig8", "pm-table5", "pm-final"), test::test_name_of);
 
 // pm-foveated: the fovea and periphery figures of each angle come with the unfoveated
 // render's figures over the same masks; the 'off' row has no mask, so it leaves them
 // empty instead of printing its whole-image error as a periphery error.
+// (PhotonQuickExperiment's checks included: this is pm-foveated's one quick run.)
 TEST(PhotonFoveated, EachMaskedErrorHasTheUnfoveatedErrorOverTheSameMask) {
     const ExperimentOutput out = test::run_quick_experiment(photon_registry(), "pm-foveated");
+    for (const std::string& note : out.notes) EXPECT_EQ(note.find("Target"), std::string::npos) << note;
     std::map<std::string, double> whole_unfoveated;  // scene → the off row's whole-image relMSE
     int angled = 0;
     for (const json& row : out.tables.at(0).rows) {
@@ -161,13 +163,14 @@ TEST_P(PhotonPaperColumns, EveryRowCarriesItsPublishedFigure) {
 INSTANTIATE_TEST_SUITE_P(Tables, PhotonPaperColumns,
                          testing::Values("pm-table1", "pm-table2", "pm-table3", "pm-table4"), test::test_name_of);
 
-// One quick pm-convergence run shared by the tests below.
+// One quick pm-convergence run (most of it the references' rendering) shared by the
+// checks below, which one test runs in one process.
 const ExperimentOutput& convergence_quick() {
     static const ExperimentOutput out = test::run_quick_experiment(photon_registry(), "pm-convergence");
     return out;
 }
 
-TEST(PhotonConvergence, RunsQuickAndFillsItsColumns) {
+void runs_quick_and_fills_its_columns() {
     // pm-convergence: every measured row has a positive time and an error that is either
     // blank or at least the reference's noise; per scene, each variant has its points, a
     // row of times to reach the targets (a number or a string saying why there is none),
@@ -227,7 +230,7 @@ double log_log_slope(const std::vector<std::pair<double, double>>& points) {
 // 2/8/32 iterations): path −1.04 (cornell), −0.93 (conference); progressive −1.40
 // (cornell), −0.46 (conference). The ranges leave about ±0.3 around those, and fail a
 // variant whose error stops falling or falls at another rate.
-TEST(PhotonConvergence, ErrorFallsWithSamplesAndIterationsAtAStatedRate) {
+void error_falls_with_samples_and_iterations_at_a_stated_rate() {
     using Range = std::pair<double, double>;
     const std::map<std::pair<std::string, std::string>, Range> slope_range = {
         {{"cornell", "path"}, {-1.3, -0.7}},
@@ -260,7 +263,7 @@ TEST(PhotonConvergence, ErrorFallsWithSamplesAndIterationsAtAStatedRate) {
 
 // Each scene's reference is the mean of two halves on independent seeds; the noise they
 // show is printed in every row and is at most a tenth of the smallest error reported.
-TEST(PhotonConvergence, TheReferenceIsAtMostATenthOfTheSmallestErrorReported) {
+void the_reference_is_at_most_a_tenth_of_the_smallest_error_reported() {
     std::map<std::string, double> noise, smallest;
     for (const json& row : convergence_quick().tables.at(0).rows) {
         const std::string scene = row.at("scene");
@@ -277,6 +280,21 @@ TEST(PhotonConvergence, TheReferenceIsAtMostATenthOfTheSmallestErrorReported) {
     for (const auto& [scene, n] : noise) {
         std::printf("[%s] reference noise %.3g, smallest error reported %.3g\n", scene.c_str(), n, smallest[scene]);
         EXPECT_LE(n, 0.1 * smallest[scene]) << scene;
+    }
+}
+
+TEST(PhotonConvergence, QuickRunFillsItsColumnsFallsAtItsRatesAndOutrunsItsReferenceNoise) {
+    {
+        SCOPED_TRACE("columns");
+        runs_quick_and_fills_its_columns();
+    }
+    {
+        SCOPED_TRACE("rates");
+        error_falls_with_samples_and_iterations_at_a_stated_rate();
+    }
+    {
+        SCOPED_TRACE("reference noise");
+        the_reference_is_at_most_a_tenth_of_the_smallest_error_reported();
     }
 }
 
