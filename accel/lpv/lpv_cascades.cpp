@@ -29,9 +29,8 @@ int LpvCascades::finest_containing(const Vec3& p) const {
     return -1;
 }
 
-Vec3 LpvCascades::irradiance_in(int k, const Vec3& p, const Vec3& n) const {
+Vec3 LpvCascades::irradiance_at(int k, const Vec3& p, const Sh4& cosine) const {
     const ShRgb I = levels_[size_t(k)].sample(p);
-    const Sh4 cosine = sh_clamped_cosine(-n);
     const float s = cell_size(k);
     const float to_radiance = 1.0f / (s * s);
     Vec3 E;
@@ -39,17 +38,29 @@ Vec3 LpvCascades::irradiance_in(int k, const Vec3& p, const Vec3& n) const {
     return E;
 }
 
-Vec3 LpvCascades::irradiance(const Vec3& p, const Vec3& n, float offset_cells) const {
+Vec3 LpvCascades::irradiance_in(int k, const Vec3& p, const Vec3& n, bool gradient_dampening) const {
+    const Sh4 cosine = sh_clamped_cosine(-n);
+    Vec3 E = irradiance_at(k, p, cosine);
+    if (!gradient_dampening) return E;
+    const Vec3 half_cell = 0.5f * cell_size(k) * n;
+    const Vec3 front = irradiance_at(k, p + half_cell, cosine);
+    const Vec3 behind = irradiance_at(k, p - half_cell, cosine);
+    for (int ch = 0; ch < 3; ++ch)
+        if (behind[ch] > front[ch]) E[ch] *= front[ch] / behind[ch];
+    return E;
+}
+
+Vec3 LpvCascades::irradiance(const Vec3& p, const Vec3& n, float offset_cells, bool gradient_dampening) const {
     for (int k = 0; k < count(); ++k) {
         const Vec3 q = p + offset_cells * cell_size(k) * n;
         const float d = border_distance(k, q);
         if (d < 0.0f) continue;
-        const Vec3 E = irradiance_in(k, q, n);
+        const Vec3 E = irradiance_in(k, q, n, gradient_dampening);
         if (d >= kBlendCells || k + 1 == count()) return E;
         const Vec3 q_coarse = p + offset_cells * cell_size(k + 1) * n;
         if (border_distance(k + 1, q_coarse) < 0.0f) return E;
         const float w = d / kBlendCells;
-        return w * E + (1.0f - w) * irradiance_in(k + 1, q_coarse, n);
+        return w * E + (1.0f - w) * irradiance_in(k + 1, q_coarse, n, gradient_dampening);
     }
     return Vec3(0);
 }

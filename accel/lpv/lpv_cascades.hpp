@@ -13,6 +13,13 @@
 // light from behind a thin wall, trilinearly interpolated, would leak through).
 // Irradiance from the intensity SH (§5): radiance L(ω) ≈ I(ω)/s² in a cell of size s,
 // and E(n) = ∫ L · max(0, −n·ω) dω over directions of travel ω, one SH dot product.
+//
+// Gradient dampening (optional): the paper dampens the lookup by the directional
+// derivative of the intensity along the normal without giving a formula; ours: the light
+// a surface receives travels towards it from the side it faces, so it cannot grow into
+// the surface. E is also evaluated half a cell in front (E₊) and half a cell behind (E₋);
+// where E₋ > E₊ the light comes from behind (a thin wall's other side, spread by the
+// trilinear lookup and the two-band SH) and E is scaled by E₊ / E₋, per channel.
 #include <vector>
 #include "accel/lpv/light_propagation_volume.hpp"
 
@@ -38,13 +45,14 @@ public:
     const LpvCascadeConfig& config() const { return config_; }
     float cell_size(int k) const { return config_.finest_cell_size * float(1 << k); }
     // Irradiance at p on a surface with unit normal n (0 outside every cascade).
-    Vec3 irradiance(const Vec3& p, const Vec3& n, float offset_cells) const;
+    Vec3 irradiance(const Vec3& p, const Vec3& n, float offset_cells, bool gradient_dampening) const;
     // The finest cascade whose cell centres enclose p, or −1.
     int finest_containing(const Vec3& p) const;
     size_t bytes() const;
 
 private:
-    Vec3 irradiance_in(int k, const Vec3& p, const Vec3& n) const;
+    Vec3 irradiance_in(int k, const Vec3& p, const Vec3& n, bool gradient_dampening) const;
+    Vec3 irradiance_at(int k, const Vec3& p, const Sh4& cosine) const;
     // Cells from p to the nearest border of cascade k's cell-centre box (< 0: outside).
     float border_distance(int k, const Vec3& p) const;
 

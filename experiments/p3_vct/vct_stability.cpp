@@ -190,7 +190,8 @@ void register_stability(ExperimentRegistry& registry) {
                      // LPV's defaults (3 cascades of 32³, cells far thicker than the wall); its
                      // geometry volume blocks only where the RSMs and the camera saw surfels.
                      leak_variant("lpv", nlohmann::json::object(), "leak_dark_room_lpv", "lpv"),
-                     leak_variant("lpv, occlusion off", {{"occlusion", false}}, "", "lpv")},
+                     leak_variant("lpv, occlusion off", {{"occlusion", false}}, "", "lpv"),
+                     leak_variant("lpv, gradient dampening", {{"gradient_dampening", true}}, "", "lpv")},
         .axes = {{"",
                   {nlohmann::json{{"dense_resolution", 128}, {"walk_size", 192}, {"walk_frames", 16},
                                   {"leak_size", 96}, {"leak_reference_spp", 64}}},

@@ -29,6 +29,9 @@ const SettingsSchema& LpvSettings::schema() {
                  "iteration on.");
         s.number("dampening", d.dampening).range(0, 4).unit("cells")
             .doc("Lookup moved this far along the normal, against self-illumination and leaking through walls.");
+        s.boolean("gradient_dampening", d.gradient_dampening)
+            .doc("Also look up half a cell in front of and behind the surface; where the light reaching it grows "
+                 "towards its back it comes through the wall, and is scaled by front / behind (per channel).");
         s.integer("light_samples", d.light_samples).range(1, 1024).doc("Samples per area-light evaluation (direct light).");
         s.integer("seed", int64_t(d.seed)).at_least(0).doc("Seed of every random stream (same seed, same image).");
         s.integer("tile_size", d.tile_size).at_least(1).unit("pixels").doc("Square screen tile of one parallel task.");
@@ -47,6 +50,7 @@ LpvSettings LpvSettings::from(const Settings& s) {
     v.iterations = schema.get<int>(s, "iterations");
     v.occlusion = schema.get<bool>(s, "occlusion");
     v.dampening = schema.get<float>(s, "dampening");
+    v.gradient_dampening = schema.get<bool>(s, "gradient_dampening");
     v.light_samples = schema.get<int>(s, "light_samples");
     v.seed = uint64_t(schema.get<int64_t>(s, "seed"));
     v.tile_size = schema.get<int>(s, "tile_size");

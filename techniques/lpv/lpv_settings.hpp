@@ -16,6 +16,7 @@ struct LpvSettings {
     int iterations = 8;        // propagation steps per cascade
     bool occlusion = true;     // fuzzy occlusion by the geometry volume
     float dampening = 0.5f;    // lookup moved this many cells along the normal
+    bool gradient_dampening = true;   // light growing into the surface is scaled down
     int light_samples = 4;     // area-light samples of the ray-traced direct light
     uint64_t seed = 1;
     int tile_size = 16;

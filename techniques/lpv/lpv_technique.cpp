@@ -206,7 +206,7 @@ void LpvTechnique::render(const ViewSet& views, std::vector<Film>& films) {
                     const PixelHit& ph = view_hits[i];
                     if (!ph.hit) continue;
                     const Material& m = scene_.materials()[ph.material];
-                    const Vec3 E = cascades_->irradiance(ph.position, ph.normal, settings_.dampening);
+                    const Vec3 E = cascades_->irradiance(ph.position, ph.normal, settings_.dampening, settings_.gradient_dampening);
                     put(indirect, i, m.albedo * kInvPi * E);
                 }
         });

@@ -125,8 +125,37 @@ TEST(LpvPropagation, AVplLightsTheHalfSpaceItFaces) {
     ASSERT_EQ(cascades.level(0).lattice().origin_cell, IVec3(0));
     cascades.level(0).inject(vpls);
     cascades.level(0).propagate(6, false);
-    EXPECT_GT(cascades.irradiance(Vec3(8, 8, 10), Vec3(0, 0, -1), 0.0f).x, 0.0f);   // ceiling above sees it
-    EXPECT_EQ(cascades.irradiance(Vec3(8, 8, 5), Vec3(0, 0, 1), 0.0f).x, 0.0f);     // floor below does not
+    EXPECT_GT(cascades.irradiance(Vec3(8, 8, 10), Vec3(0, 0, -1), 0.0f, false).x, 0.0f);   // ceiling above sees it
+    EXPECT_EQ(cascades.irradiance(Vec3(8, 8, 5), Vec3(0, 0, 1), 0.0f, false).x, 0.0f);     // floor below does not
+}
+
+// Gradient dampening: a VPL on the underside of a thin floor (z = 8, facing −z) lights
+// the room below; the floor's top side, looked up where the trilinear lookup reaches the
+// cell below, sees that light growing towards its back and keeps little of it, while a
+// floor lower down, lit from the side it faces, keeps all of it.
+TEST(LpvPropagation, GradientDampeningCutsLightFromBehindAndKeepsLightFromTheFront) {
+    const int r = 16;
+    LpvCascadeConfig config;
+    config.cascades = 1;
+    config.resolution = r;
+    LpvCascades cascades(config);
+    cascades.place(Vec3(8.0f));
+    ASSERT_EQ(cascades.level(0).lattice().origin_cell, IVec3(0));
+    const std::vector<VirtualPointLight> vpls = {vpl_at(Vec3(8.5f, 8.5f, 8.001f), Vec3(0, 0, -1), 1.0f)};
+    ASSERT_EQ(cascades.level(0).inject(vpls), 1u);
+    cascades.level(0).propagate(6, false);
+
+    const Vec3 top(8.5f, 8.5f, 8.0f), up(0, 0, 1);
+    const float leaked = cascades.irradiance(top, up, 0.0f, false).x;
+    const float damped = cascades.irradiance(top, up, 0.0f, true).x;
+    std::printf("floor's top side: %.5f undamped, %.5f damped\n", leaked, damped);
+    EXPECT_GT(leaked, 0.0f);
+    EXPECT_LT(damped, 0.25f * leaked);
+
+    const Vec3 lower_floor(8.5f, 8.5f, 4.0f);
+    const float lit = cascades.irradiance(lower_floor, up, 0.5f, false).x;
+    EXPECT_GT(lit, 0.0f);
+    EXPECT_EQ(cascades.irradiance(lower_floor, up, 0.5f, true).x, lit);
 }
 
 TEST(LpvPropagation, AWallInTheGeometryVolumeBlocksTheFluxBehindIt) {
