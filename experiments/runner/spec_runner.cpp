@@ -363,11 +363,13 @@ int render_task_references(const ExperimentSpec& spec, int task_id, const Experi
         for (const ReferenceView& view : (*references)(call)) path_reference(ctx, view, files);
     }
     // What rendering them cost, for the sweep's time figures (the task results do not hold it).
+    // A later run (a resume) finds them in the store: the first run's record is kept.
+    const fs::path cost_file = spec_references_cost_file(ctx.output_dir, task.id, ctx.quick);
+    if (fs::exists(cost_file)) return int(files.size());
     nlohmann::json cost = {{"seconds", watch.elapsed_ms() / 1000.0},
                            {"cpu_seconds", process_cpu_seconds() - cpu_start},
                            {"threads", ctx.threads > 0 ? ctx.threads : int(machine_description()["tbb_threads"])},
                            {"references", files.size()}};
-    const fs::path cost_file = spec_references_cost_file(ctx.output_dir, task.id, ctx.quick);
     fs::create_directories(cost_file.parent_path());
     write_file_atomically(cost_file, cost.dump(2) + "\n");
     return int(files.size());

@@ -148,11 +148,16 @@ TEST_F(SweepLocal, AFailedTaskIsMissingFromTheMergeUntilResumed) {
     EXPECT_EQ(status.exit_code, 0) << status.output;
     EXPECT_TRUE(contains(status.output, "pm-radius-sweep: 3 done, 1 without result (2)")) << status.output;
 
+    // The resume finds the task's references in the store: the record of what rendering
+    // them cost stays the first run's.
+    const fs::path reference_cost = results / "pm-radius-sweep" / "tasks" / "quick" / "references" / "0.json";
+    const nlohmann::json first_cost = read_json(reference_cost);
     // The global --threads gives the resumed tasks their threads, as when a sweep starts.
     const GilabRun resumed = run_gilab({"--threads", "3", "sweep", "resume", (results / ".sweep").string()});
     ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
     EXPECT_TRUE(contains(resumed.output, "6 have a result already, 1 to run")) << resumed.output;
     EXPECT_TRUE(contains(resumed.output, "with 3 thread(s) each")) << resumed.output;
+    EXPECT_EQ(read_json(reference_cost), first_cost);
     EXPECT_TRUE(read_json(results / "pm-radius-sweep" / "results.json")["config"]["effective"]["tasks_missing"].empty());
     const std::string done = run_gilab({"sweep", "status", (results / ".sweep").string()}).output;
     EXPECT_TRUE(contains(done, "total: 7 done, 0 running")) << done;
