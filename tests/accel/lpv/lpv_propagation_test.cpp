@@ -69,6 +69,16 @@ LpvLattice unit_lattice(int resolution) {
     return l;
 }
 
+// One cascade of r³ unit cells centred on (8, 8, 8): with r = 16 its cell (0, 0, 0) is at the origin.
+LpvCascades one_unit_cascade(int r) {
+    LpvCascadeConfig config;
+    config.cascades = 1;
+    config.resolution = r;
+    LpvCascades cascades(config);
+    cascades.place(Vec3(8.0f));
+    return cascades;
+}
+
 VirtualPointLight vpl_at(const Vec3& p, const Vec3& n, float flux) { return {p, n, Vec3(flux)}; }
 
 TEST(LpvPropagation, ConservesFluxUpToWhatLeavesTheGrid) {
@@ -117,11 +127,7 @@ TEST(LpvPropagation, AVplLightsTheHalfSpaceItFaces) {
     EXPECT_LT(std::abs(behind), 0.03 * front);
     // The lookup on the lit side sees it, on the other side of the surface (a floor's
     // underside facing −z) nothing.
-    LpvCascadeConfig config;
-    config.cascades = 1;
-    config.resolution = r;
-    LpvCascades cascades(config);
-    cascades.place(Vec3(8.0f));
+    LpvCascades cascades = one_unit_cascade(r);
     ASSERT_EQ(cascades.level(0).lattice().origin_cell, IVec3(0));
     cascades.level(0).inject(vpls);
     cascades.level(0).propagate(6, false);
@@ -135,11 +141,7 @@ TEST(LpvPropagation, AVplLightsTheHalfSpaceItFaces) {
 // floor lower down, lit from the side it faces, keeps all of it.
 TEST(LpvPropagation, GradientDampeningCutsLightFromBehindAndKeepsLightFromTheFront) {
     const int r = 16;
-    LpvCascadeConfig config;
-    config.cascades = 1;
-    config.resolution = r;
-    LpvCascades cascades(config);
-    cascades.place(Vec3(8.0f));
+    LpvCascades cascades = one_unit_cascade(r);
     ASSERT_EQ(cascades.level(0).lattice().origin_cell, IVec3(0));
     const std::vector<VirtualPointLight> vpls = {vpl_at(Vec3(8.5f, 8.5f, 8.001f), Vec3(0, 0, -1), 1.0f)};
     ASSERT_EQ(cascades.level(0).inject(vpls), 1u);
