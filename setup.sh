@@ -49,7 +49,7 @@ case "$mode" in
     # The suite again, built with AddressSanitizer and UBSan at -O1 (a finding fails its
     # test), without the tests labelled heavy (the whole experiments at quick size and the
     # every-shipped-scene renders, which the sanitizers slow about tenfold), slurm and
-    # browser (they time the Slurm daemons and Chromium, which no sanitizer build changes;
+    # browser (they start the Slurm daemons and Chromium, which no sanitizer build changes;
     # the sweep and report code they drive runs sanitized in the sweep and report tests).
     cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O1 -DNDEBUG" \
       -DGILAB_SANITIZE=ON -DGILAB_BUILD_BENCHMARKS=OFF
