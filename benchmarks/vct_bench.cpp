@@ -15,7 +15,8 @@
 //    from a one-voxel neighbourhood (cache-resident), scattered over the finest level,
 //    or scattered over every level; with or without the clip plane.
 // Args name the structure (0 cascaded, 1 dense) and, where given, the worker threads
-// (0: all cores). Set-up (loading, voxelizing, the first injection) happens once per
+// (0: all cores) and the sampling kernel (0 portable SSE2, 1 AVX2 + FMA + F16C; see
+// ConeKernel), so one run gives the kernels' ratio. Set-up (loading, voxelizing, the first injection) happens once per
 // process, outside the timed loops. Sponza comes from GILAB_ASSETS or ../shared/scenes.
 #include <benchmark/benchmark.h>
 
@@ -130,14 +131,23 @@ PointCones cones_at(const VoxelConeView& view, const VctSettings& s, const Bound
     return pc;
 }
 
-void set_structure_label(benchmark::State& state, int structure, int threads) {
+// The avx2 kernel runs only where the CPU has it; elsewhere its benchmarks say so.
+bool kernel_available(benchmark::State& state, ConeKernel kernel) {
+    if (kernel == ConeKernel::avx2 && best_cone_kernel() != ConeKernel::avx2) {
+        state.SkipWithError("this CPU lacks AVX2, FMA or F16C: no avx2 kernel");
+        return false;
+    }
+    return true;
+}
+
+void set_structure_label(benchmark::State& state, int structure, int threads, const std::string& more = "") {
     state.SetLabel(std::string(kStructureNames[structure]) + ", " +
-                   (threads > 0 ? std::to_string(threads) + " thread(s)" : std::string("all cores")));
+                   (threads > 0 ? std::to_string(threads) + " thread(s)" : std::string("all cores")) + more);
 }
 
 // One pass over every G-buffer point's diffuse cones; returns the samples taken.
 uint64_t march_all(const VoxelConeView& view, const SponzaScene& s, const ConeSet& set,
-                   const std::vector<PointCones>& setup) {
+                   const std::vector<PointCones>& setup, ConeKernel kernel) {
     std::atomic<uint64_t> samples{0};
     parallel_for(s.points.size(), 64, [&](size_t b, size_t e) {
         uint64_t local = 0;
@@ -146,7 +156,7 @@ uint64_t march_all(const VoxelConeView& view, const SponzaScene& s, const ConeSe
             const Frame frame(s.points[i].normal);
             for (size_t c = 0; c < set.directions.size(); ++c) {
                 const Cone cone{setup[i].apex, frame.to_world(set.directions[c]), set.tan_half_angle};
-                const ConeResult r = trace_cone(view, cone, setup[i].options);
+                const ConeResult r = trace_cone(view, cone, setup[i].options, kernel);
                 sum += r.radiance;
                 local += uint64_t(r.samples);
             }
@@ -157,14 +167,15 @@ uint64_t march_all(const VoxelConeView& view, const SponzaScene& s, const ConeSe
     return samples.load();
 }
 
-void time_march(benchmark::State& state, const VoxelConeView& view, const VctTechnique& t) {
+void time_march(benchmark::State& state, const VoxelConeView& view, const VctTechnique& t,
+                ConeKernel kernel = best_cone_kernel()) {
     const SponzaScene& s = *sponza();
     const ConeSet set = hemisphere_cones(kDiffuseCones);
     std::vector<PointCones> setup;
     for (const GbufferPoint& p : s.points) setup.push_back(cones_at(view, t.settings(), s.bounds, p));
-    const uint64_t per_pass = march_all(view, s, set, setup);  // warm-up, outside the timed loop
+    const uint64_t per_pass = march_all(view, s, set, setup, kernel);  // warm-up, outside the timed loop
     uint64_t total = 0;
-    for (auto _ : state) total += march_all(view, s, set, setup);
+    for (auto _ : state) total += march_all(view, s, set, setup, kernel);
     const double cones = double(s.points.size()) * double(set.directions.size());
     state.counters["points"] = double(s.points.size());
     state.counters["samples_per_cone"] = double(per_pass) / cones;
@@ -177,14 +188,16 @@ void time_march(benchmark::State& state, const VoxelConeView& view, const VctTec
 void BM_ConeMarch(benchmark::State& state) {
     if (!need_sponza(state)) return;
     const int structure = int(state.range(0)), threads = int(state.range(1));
+    const ConeKernel kernel = state.range(2) ? ConeKernel::avx2 : ConeKernel::portable;
+    if (!kernel_available(state, kernel)) return;
     VctTechnique& t = technique(structure);
     ThreadLimit limit(threads);
-    time_march(state, t.radiance_view(), t);
-    set_structure_label(state, structure, threads);
+    time_march(state, t.radiance_view(), t, kernel);
+    set_structure_label(state, structure, threads, std::string(", ") + to_string(kernel) + " kernel");
 }
 BENCHMARK(BM_ConeMarch)
-    ->ArgsProduct({{0, 1}, {1, 0}})
-    ->ArgNames({"structure", "threads"})
+    ->ArgsProduct({{0, 1}, {1, 0}, {0, 1}})
+    ->ArgNames({"structure", "threads", "kernel"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
@@ -329,6 +342,8 @@ void BM_SampleLevel(benchmark::State& state) {
     if (!need_sponza(state)) return;
     const int structure = int(state.range(0)), pattern = int(state.range(1));
     const bool with_plane = state.range(2) != 0;
+    const ConeKernel kernel = state.range(3) ? ConeKernel::avx2 : ConeKernel::portable;
+    if (!kernel_available(state, kernel)) return;
     VctTechnique& t = technique(structure);
     const VoxelConeView view = t.radiance_view();
     const Vec3 centre = sponza()->points[sponza()->points.size() / 2].position;
@@ -361,7 +376,7 @@ void BM_SampleLevel(benchmark::State& state) {
     Vec4 sum(0);
     for (auto _ : state) {
         for (size_t i = 0; i < kCount; ++i)
-            sum += view.sample_level(level[i], position[i], faces[i], with_plane ? &plane[i] : nullptr);
+            sum += view.sample_level(level[i], position[i], faces[i], with_plane ? &plane[i] : nullptr, kernel);
         benchmark::DoNotOptimize(sum);
     }
     const double n = double(state.iterations()) * double(kCount);
@@ -369,11 +384,11 @@ void BM_SampleLevel(benchmark::State& state) {
     state.counters["s_per_sample"] = benchmark::Counter(n, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
     static const char* const kPatterns[] = {"one voxel", "finest level", "every level"};
     state.SetLabel(std::string(kStructureNames[structure]) + ", " + kPatterns[pattern] +
-                   (with_plane ? ", clip plane" : ""));
+                   (with_plane ? ", clip plane" : "") + ", " + to_string(kernel) + " kernel");
 }
 BENCHMARK(BM_SampleLevel)
-    ->ArgsProduct({{0, 1}, {0, 1, 2}, {0, 1}})
-    ->ArgNames({"structure", "pattern", "plane"})
+    ->ArgsProduct({{0, 1}, {0, 1, 2}, {0, 1}, {0, 1}})
+    ->ArgNames({"structure", "pattern", "plane", "kernel"})
     ->Unit(benchmark::kMicrosecond);
 
 }  // namespace

@@ -6,6 +6,12 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define GILAB_CONE_AVX2 1
+#include <immintrin.h>
+#else
+#define GILAB_CONE_AVX2 0
+#endif
 #include "core/util/error.hpp"
 
 namespace gilab {
@@ -69,53 +75,90 @@ VoxelConeView VoxelConeView::dense(const DenseMipTexture& t, const std::vector<s
 namespace {
 
 // floor(x) as an int for |x| < 2^31, without a libm call.
-inline int floor_to_int(float x) {
+[[gnu::always_inline]] inline int floor_to_int(float x) {
     const int i = int(x);
     return i - int(x < float(i));
 }
 
-// The eight texels of one trilinear sample: cell offsets along x, y, z and the weights.
+// The eight texels of one trilinear sample: per axis (x, y, z) the two cell offsets and
+// weights; texel k (0…7) takes bit 0 of k along x, bit 1 along y, bit 2 along z.
 struct SampleCorners {
     IVec3 i0, i1;               // lower and upper voxel (world voxel coordinates of the level)
-    size_t x[2], y[2], z[2];    // cell offsets
-    float wx[2], wy[2], wz[2];
+    size_t offset[3][2];        // in cells
+    float weight[3][2];
     size_t occupancy;           // texel of i0 in the occupancy map
 };
 
 // q: the position in the level's voxel units. Clamped to the centres of the level's
 // border voxels, so a sample never reads outside the level or wraps around.
-SampleCorners corners_of(const ConeLevel& l, const Vec3& q_unclamped) {
+[[gnu::always_inline]] inline SampleCorners corners_of(const ConeLevel& l, const Vec3& q_unclamped) {
     SampleCorners c;
+    const size_t stride[3] = {l.x_stride, l.row_stride, l.slice_stride};
     for (int a = 0; a < 3; ++a) {
-        const float lo = float(l.origin[a]), hi = float(l.origin[a] + l.size - 1);
-        const float q = std::min(std::max(q_unclamped[a] - 0.5f, lo), hi);
+        const int lo = l.origin[a], hi = l.origin[a] + l.size - 1;
+        const float q = std::min(std::max(q_unclamped[a] - 0.5f, float(lo)), float(hi));
         const int i0 = floor_to_int(q);
+        const int i1 = std::min(i0 + 1, hi);
         c.i0[a] = i0;
-        c.i1[a] = std::min(i0 + 1, l.origin[a] + l.size - 1);
+        c.i1[a] = i1;
+        c.offset[a][0] = size_t(i0 & l.wrap_mask) * stride[a];
+        c.offset[a][1] = size_t(i1 & l.wrap_mask) * stride[a];
         const float t = q - float(i0);
-        const size_t stride = a == 0 ? l.x_stride : a == 1 ? l.row_stride : l.slice_stride;
-        size_t* offset = a == 0 ? c.x : a == 1 ? c.y : c.z;
-        float* w = a == 0 ? c.wx : a == 1 ? c.wy : c.wz;
-        offset[0] = size_t(i0 & l.wrap_mask) * stride;
-        offset[1] = size_t(c.i1[a] & l.wrap_mask) * stride;
-        w[0] = 1.0f - t;
-        w[1] = t;
+        c.weight[a][0] = 1.0f - t;
+        c.weight[a][1] = t;
     }
     c.occupancy = size_t(c.i0.z & l.wrap_mask) * l.occupancy_slice + size_t(c.i0.y & l.wrap_mask) * l.occupancy_row +
                   size_t(c.i0.x & l.wrap_mask);
     return c;
 }
 
+[[gnu::always_inline]] inline size_t texel_offset(const SampleCorners& c, int k) {
+    return c.offset[2][k >> 2] + c.offset[1][(k >> 1) & 1] + c.offset[0][k & 1];
+}
+[[gnu::always_inline]] inline float texel_weight(const SampleCorners& c, int k) {
+    return (c.weight[2][k >> 2] * c.weight[1][(k >> 1) & 1]) * c.weight[0][k & 1];
+}
+
+// The clip plane's mask: keep[f][k] is 0 where face f of texel k is skipped. Voxels
+// entirely behind the plane are empty; voxels it cuts hold the cone's own surface, so
+// their faces turned away from the plane (the surface's back side, seen only through the
+// wide trilinear footprint of a coarse level) are skipped.
+[[gnu::always_inline]] inline void clip_mask(const ConeLevel& l, const Vec3& anchor, const SampleCorners& c,
+                                             const FaceWeights& faces, const Vec4& plane, float (*keep)[8]) {
+    float keep_back[8] = {1, 1, 1, 1, 1, 1, 1, 1}, keep_front[8] = {1, 1, 1, 1, 1, 1, 1, 1};
+    const Vec3 n(plane);
+    // A hair more than half a voxel, so a surface lying on a voxel face counts as cut.
+    const float half = 0.501f * l.voxel_size * (std::abs(n.x) + std::abs(n.y) + std::abs(n.z));
+    const IVec3 i[2] = {c.i0, c.i1};
+    float sx[2], sy[2], sz[2];
+    for (int k = 0; k < 2; ++k) {
+        sx[k] = n.x * (anchor.x + (float(i[k].x) + 0.5f) * l.voxel_size);
+        sy[k] = n.y * (anchor.y + (float(i[k].y) + 0.5f) * l.voxel_size);
+        sz[k] = n.z * (anchor.z + (float(i[k].z) + 0.5f) * l.voxel_size);
+    }
+    for (int k = 0; k < 8; ++k) {
+        const float s = sx[k & 1] + sy[(k >> 1) & 1] + sz[k >> 2] - plane.w;
+        if (s + half <= 0.0f) keep_back[k] = keep_front[k] = 0.0f;  // behind
+        else if (s - half <= 0.0f) keep_back[k] = 0.0f;              // cut
+    }
+    for (int f = 0; f < 3; ++f) {
+        const bool front = glm::dot(face_direction(faces.face[size_t(f)]), n) >= -1e-6f;
+        std::copy_n(front ? keep_front : keep_back, 8, keep[f]);
+    }
+}
+
+// ---- portable kernel: SSE2 (every x86-64) or scalar.
 // Σ over the eight texels and the three faces of weight(texel, face) × value, where a
 // texel's weight is its trilinear weight × keep[face][texel]. RGBA16F values are read as
 // their bits shifted up by 13 (see half_rgba.hpp) and the weights carry 2^112.
 template <bool kClip>
-Vec4 accumulate(const ConeLevel& l, const SampleCorners& c, const FaceWeights& faces, const float (*keep)[8]) {
+[[gnu::always_inline]] inline Vec4 accumulate_portable(const ConeLevel& l, const SampleCorners& c,
+                                                       const FaceWeights& faces, const float (*keep)[8]) {
     const HalfRGBA* face0 = l.data + size_t(faces.face[0]) * l.face_stride;
     const HalfRGBA* face1 = l.data + size_t(faces.face[1]) * l.face_stride;
     const HalfRGBA* face2 = l.data + size_t(faces.face[2]) * l.face_stride;
     float w[8];
-    for (int k = 0; k < 8; ++k) w[k] = (c.wz[k >> 2] * c.wy[(k >> 1) & 1]) * (c.wx[k & 1] * kHalfBitsScale);
+    for (int k = 0; k < 8; ++k) w[k] = texel_weight(c, k) * kHalfBitsScale;
 #if defined(__SSE2__)
     __m128 a0 = _mm_setzero_ps(), a1 = _mm_setzero_ps(), a2 = _mm_setzero_ps();
     const __m128i zero = _mm_setzero_si128();
@@ -124,7 +167,7 @@ Vec4 accumulate(const ConeLevel& l, const SampleCorners& c, const FaceWeights& f
         return _mm_castsi128_ps(_mm_slli_epi32(_mm_unpacklo_epi16(v, zero), 13));
     };
     for (int k = 0; k < 8; ++k) {
-        const size_t off = c.z[k >> 2] + c.y[(k >> 1) & 1] + c.x[k & 1];
+        const size_t off = texel_offset(c, k);
         if constexpr (kClip) {
             a0 = _mm_add_ps(a0, _mm_mul_ps(bits(face0 + off), _mm_set1_ps(w[k] * keep[0][k])));
             a1 = _mm_add_ps(a1, _mm_mul_ps(bits(face1 + off), _mm_set1_ps(w[k] * keep[1][k])));
@@ -149,7 +192,7 @@ Vec4 accumulate(const ConeLevel& l, const SampleCorners& c, const FaceWeights& f
     };
     Vec4 a0(0.0f), a1(0.0f), a2(0.0f);
     for (int k = 0; k < 8; ++k) {
-        const size_t off = c.z[k >> 2] + c.y[(k >> 1) & 1] + c.x[k & 1];
+        const size_t off = texel_offset(c, k);
         a0 += bits(face0 + off) * (kClip ? w[k] * keep[0][k] : w[k]);
         a1 += bits(face1 + off) * (kClip ? w[k] * keep[1][k] : w[k]);
         a2 += bits(face2 + off) * (kClip ? w[k] * keep[2][k] : w[k]);
@@ -158,50 +201,89 @@ Vec4 accumulate(const ConeLevel& l, const SampleCorners& c, const FaceWeights& f
 #endif
 }
 
-}  // namespace
-
-namespace {
-
-// sample_level's work, inlined into the cone loop.
-[[gnu::always_inline]] inline Vec4 sample(const ConeLevel& l, const Vec3& anchor_, const Vec3& p,
-                                          const FaceWeights& faces, const Vec4* plane) {
-    const SampleCorners c = corners_of(l, (p - anchor_) * l.inv_voxel_size);
+// One trilinear, face-weighted sample (position p in world units).
+[[gnu::always_inline]] inline Vec4 sample_portable(const ConeLevel& l, const Vec3& anchor, const Vec3& p,
+                                                   const FaceWeights& faces, const Vec4* plane) {
+    const SampleCorners c = corners_of(l, (p - anchor) * l.inv_voxel_size);
     if (l.occupancy && !l.occupancy[c.occupancy]) return Vec4(0.0f);  // all eight texels empty
-    if (!plane) return accumulate<false>(l, c, faces, nullptr);
-    // Clip plane: voxels entirely behind it are empty; voxels it cuts hold the cone's own
-    // surface, so their faces turned away from the plane (the surface's back side, seen
-    // only through the wide trilinear footprint of a coarse level) are skipped.
-    float keep_back[8] = {1, 1, 1, 1, 1, 1, 1, 1}, keep_front[8] = {1, 1, 1, 1, 1, 1, 1, 1};
-    const Vec3 n(*plane);
-    // A hair more than half a voxel, so a surface lying on a voxel face counts as cut.
-    const float half = 0.501f * l.voxel_size * (std::abs(n.x) + std::abs(n.y) + std::abs(n.z));
-    const IVec3 i[2] = {c.i0, c.i1};
-    float sx[2], sy[2], sz[2];
-    for (int k = 0; k < 2; ++k) {
-        sx[k] = n.x * (anchor_.x + (float(i[k].x) + 0.5f) * l.voxel_size);
-        sy[k] = n.y * (anchor_.y + (float(i[k].y) + 0.5f) * l.voxel_size);
-        sz[k] = n.z * (anchor_.z + (float(i[k].z) + 0.5f) * l.voxel_size);
-    }
-    for (int k = 0; k < 8; ++k) {
-        const float s = sx[k & 1] + sy[(k >> 1) & 1] + sz[k >> 2] - plane->w;
-        if (s + half <= 0.0f) keep_back[k] = keep_front[k] = 0.0f;  // behind
-        else if (s - half <= 0.0f) keep_back[k] = 0.0f;              // cut
-    }
+    if (!plane) return accumulate_portable<false>(l, c, faces, nullptr);
     float keep[3][8];
-    for (int f = 0; f < 3; ++f) {
-        const bool front = glm::dot(face_direction(faces.face[size_t(f)]), n) >= -1e-6f;
-        std::copy_n(front ? keep_front : keep_back, 8, keep[f]);
+    clip_mask(l, anchor, c, faces, *plane, keep);
+    return accumulate_portable<true>(l, c, faces, keep);
+}
+
+#if GILAB_CONE_AVX2
+// ---- AVX2 kernel: the eight texel weights and the clip plane's mask in one 8-wide
+// register each; F16C converts a texel's four halves in one instruction and FMA folds the
+// weighting (the same sums as the portable kernel in another order, with fused rounding).
+__attribute__((target("avx2,fma,f16c"))) Vec4 sample_avx2(const ConeLevel& l, const Vec3& anchor, const Vec3& p,
+                                                          const FaceWeights& faces, const Vec4* plane) {
+    const SampleCorners c = corners_of(l, (p - anchor) * l.inv_voxel_size);
+    if (l.occupancy && !l.occupancy[c.occupancy]) return Vec4(0.0f);  // all eight texels empty
+    // Texel k = (x: bit 0, y: bit 1, z: bit 2), as texel_offset.
+    const __m256 wx = _mm256_setr_ps(c.weight[0][0], c.weight[0][1], c.weight[0][0], c.weight[0][1], c.weight[0][0],
+                                     c.weight[0][1], c.weight[0][0], c.weight[0][1]);
+    const __m256 wy = _mm256_setr_ps(c.weight[1][0], c.weight[1][0], c.weight[1][1], c.weight[1][1], c.weight[1][0],
+                                     c.weight[1][0], c.weight[1][1], c.weight[1][1]);
+    const __m256 wz = _mm256_setr_ps(c.weight[2][0], c.weight[2][0], c.weight[2][0], c.weight[2][0], c.weight[2][1],
+                                     c.weight[2][1], c.weight[2][1], c.weight[2][1]);
+    const __m256 w = _mm256_mul_ps(_mm256_mul_ps(wz, wy), wx);
+    alignas(32) float wf[3][8];
+    if (!plane) {
+        _mm256_store_ps(wf[0], w);
+        _mm256_store_ps(wf[1], w);
+        _mm256_store_ps(wf[2], w);
+    } else {
+        // clip_mask's rule: a voxel whose centre lies more than `half` behind the plane is
+        // empty; one the plane cuts keeps only its faces turned towards the plane's front.
+        const Vec3 n(*plane);
+        const float half = 0.501f * l.voxel_size * (std::abs(n.x) + std::abs(n.y) + std::abs(n.z));
+        float s[3][2];
+        const IVec3 i[2] = {c.i0, c.i1};
+        for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 2; ++b) s[a][b] = n[a] * (anchor[a] + (float(i[b][a]) + 0.5f) * l.voxel_size);
+        const __m256 sx = _mm256_setr_ps(s[0][0], s[0][1], s[0][0], s[0][1], s[0][0], s[0][1], s[0][0], s[0][1]);
+        const __m256 sy = _mm256_setr_ps(s[1][0], s[1][0], s[1][1], s[1][1], s[1][0], s[1][0], s[1][1], s[1][1]);
+        const __m256 sz = _mm256_setr_ps(s[2][0], s[2][0], s[2][0], s[2][0], s[2][1], s[2][1], s[2][1], s[2][1]);
+        const __m256 d = _mm256_sub_ps(_mm256_add_ps(_mm256_add_ps(sx, sy), sz), _mm256_set1_ps(plane->w));
+        const __m256 h = _mm256_set1_ps(half);
+        const __m256 front = _mm256_and_ps(w, _mm256_cmp_ps(_mm256_add_ps(d, h), _mm256_setzero_ps(), _CMP_GT_OQ));
+        const __m256 back = _mm256_and_ps(w, _mm256_cmp_ps(_mm256_sub_ps(d, h), _mm256_setzero_ps(), _CMP_GT_OQ));
+        for (int f = 0; f < 3; ++f) {
+            // Face 2a looks along +a, face 2a + 1 along −a (anisotropic_voxel.hpp).
+            const int face = faces.face[size_t(f)], axis = face >> 1;
+            const float towards = (face & 1) ? -n[axis] : n[axis];
+            _mm256_store_ps(wf[f], towards >= -1e-6f ? front : back);
+        }
     }
-    return accumulate<true>(l, c, faces, keep);
+    const HalfRGBA* face0 = l.data + size_t(faces.face[0]) * l.face_stride;
+    const HalfRGBA* face1 = l.data + size_t(faces.face[1]) * l.face_stride;
+    const HalfRGBA* face2 = l.data + size_t(faces.face[2]) * l.face_stride;
+    // Two accumulators per face (even and odd texels) halve the chain of dependent FMAs.
+    __m128 a[3][2] = {{_mm_setzero_ps(), _mm_setzero_ps()}, {_mm_setzero_ps(), _mm_setzero_ps()},
+                      {_mm_setzero_ps(), _mm_setzero_ps()}};
+#define GILAB_TEXEL(face, off) _mm_cvtph_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>((face) + (off))))
+    for (int k = 0; k < 8; ++k) {
+        const size_t off = texel_offset(c, k);
+        a[0][k & 1] = _mm_fmadd_ps(GILAB_TEXEL(face0, off), _mm_broadcast_ss(&wf[0][k]), a[0][k & 1]);
+        a[1][k & 1] = _mm_fmadd_ps(GILAB_TEXEL(face1, off), _mm_broadcast_ss(&wf[1][k]), a[1][k & 1]);
+        a[2][k & 1] = _mm_fmadd_ps(GILAB_TEXEL(face2, off), _mm_broadcast_ss(&wf[2][k]), a[2][k & 1]);
+    }
+#undef GILAB_TEXEL
+    __m128 sum = _mm_mul_ps(_mm_add_ps(a[0][0], a[0][1]), _mm_set1_ps(faces.weight[0]));
+    sum = _mm_fmadd_ps(_mm_add_ps(a[1][0], a[1][1]), _mm_set1_ps(faces.weight[1]), sum);
+    sum = _mm_fmadd_ps(_mm_add_ps(a[2][0], a[2][1]), _mm_set1_ps(faces.weight[2]), sum);
+    alignas(16) float out[4];
+    _mm_store_ps(out, sum);
+    return {out[0], out[1], out[2], out[3]};
 }
+#endif
 
-}  // namespace
+using SampleFn = Vec4 (*)(const ConeLevel&, const Vec3&, const Vec3&, const FaceWeights&, const Vec4*);
 
-Vec4 VoxelConeView::sample_level(int level, const Vec3& p, const FaceWeights& faces, const Vec4* plane) const {
-    return sample(levels_[size_t(level)], anchor_, p, faces, plane);
-}
-
-ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOptions& options) {
+// The cone loop, instantiated once per kernel.
+template <SampleFn kSample>
+[[gnu::always_inline]] inline ConeResult march(const VoxelConeView& view, const Cone& cone, const ConeOptions& options) {
     ConeResult r;
     const int n = view.level_count();
     if (n == 0) return r;
@@ -211,7 +293,7 @@ ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOpt
     const FaceWeights faces = faces_seen_along(cone.direction);
     const Vec4* plane = options.clip ? &options.clip_plane : nullptr;
     // A sample farther in front of the clip plane than its eight voxel centres reach (one
-    // voxel per axis) plus sample_level's half-voxel test is never clipped; blending also
+    // voxel per axis) plus clip_mask's half-voxel test is never clipped; blending also
     // reads the next level, of twice the voxel.
     const float plane_reach = plane ? 1.502f * (options.blend_levels ? 2.0f : 1.0f) *
                                           (std::abs(plane->x) + std::abs(plane->y) + std::abs(plane->z))
@@ -237,19 +319,19 @@ ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOpt
         // a coarser level (then that level's voxel) or beyond the coarsest.
         const float voxel = l0 > lod ? view.level(l0).voxel_size : std::clamp(lod_width, w0, coarsest);
         const Vec4* clip = plane && glm::dot(Vec3(*plane), p) - plane->w <= plane_reach * voxel ? plane : nullptr;
-        Vec4 s = sample(view.level(l0), view.anchor(), p, faces, clip);
+        Vec4 s = kSample(view.level(l0), view.anchor(), p, faces, clip);
         if (options.blend_levels && l0 + 1 < n) {
             const float frac = std::log2(voxel / view.level(l0).voxel_size);
-            if (frac > 0.0f) s = glm::mix(s, sample(view.level(l0 + 1), view.anchor(), p, faces, clip), frac);
+            if (frac > 0.0f) s = glm::mix(s, kSample(view.level(l0 + 1), view.anchor(), p, faces, clip), frac);
         }
         const float step = voxel * options.step;  // the sampled level's voxel: never skips over it
         ++r.samples;
         if (s.a > 1e-6f) {
             const float a = std::min(s.a, 0.9999f);
             const float corrected = options.correct_opacity ? 1.0f - std::pow(1.0f - a, step / voxel) : a;
-            const Vec3 c = Vec3(s) * (corrected / s.a);
+            const Vec3 col = Vec3(s) * (corrected / s.a);
             const float t = 1.0f - r.opacity;
-            r.radiance += t * c;
+            r.radiance += t * col;
             const float radius = 0.5f * diameter / w0;
             r.occlusion += (1.0f - r.occlusion) * corrected / (1.0f + options.ao_lambda * radius);
             r.opacity += t * corrected;
@@ -258,6 +340,65 @@ ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOpt
         dist += step;
     }
     return r;
+}
+
+ConeResult trace_cone_portable(const VoxelConeView& view, const Cone& cone, const ConeOptions& options) {
+    return march<sample_portable>(view, cone, options);
+}
+
+#if GILAB_CONE_AVX2
+__attribute__((target("avx2,fma,f16c"))) ConeResult trace_cone_avx2(const VoxelConeView& view, const Cone& cone,
+                                                                    const ConeOptions& options) {
+    return march<sample_avx2>(view, cone, options);
+}
+#endif
+
+void require_supported(ConeKernel kernel) {
+    if (kernel == ConeKernel::avx2 && best_cone_kernel() != ConeKernel::avx2)
+        throw Error("cone tracer", "the avx2 cone kernel needs a CPU with AVX2, FMA and F16C");
+}
+
+}  // namespace
+
+ConeKernel best_cone_kernel() {
+#if GILAB_CONE_AVX2
+    static const ConeKernel best = [] {
+        __builtin_cpu_init();
+        return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("f16c")
+                   ? ConeKernel::avx2
+                   : ConeKernel::portable;
+    }();
+    return best;
+#else
+    return ConeKernel::portable;
+#endif
+}
+
+const char* to_string(ConeKernel kernel) { return kernel == ConeKernel::avx2 ? "avx2" : "portable"; }
+
+Vec4 VoxelConeView::sample_level(int level, const Vec3& p, const FaceWeights& faces, const Vec4* plane,
+                                 ConeKernel kernel) const {
+    require_supported(kernel);
+    const ConeLevel& l = levels_[size_t(level)];
+#if GILAB_CONE_AVX2
+    if (kernel == ConeKernel::avx2) return sample_avx2(l, anchor_, p, faces, plane);
+#endif
+    return sample_portable(l, anchor_, p, faces, plane);
+}
+
+ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOptions& options, ConeKernel kernel) {
+#if GILAB_CONE_AVX2
+    if (kernel == ConeKernel::avx2) {
+        require_supported(kernel);
+        return trace_cone_avx2(view, cone, options);
+    }
+#endif
+    require_supported(kernel);
+    return trace_cone_portable(view, cone, options);
+}
+
+ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOptions& options) {
+    return trace_cone(view, cone, options, best_cone_kernel());
 }
 
 ConeSet hemisphere_cones(int count) {

@@ -11,8 +11,8 @@
 // level border or wraps around the toroidal storage (optionally, fractional levels blend
 // the two nearest levels). The three faces turned towards the apex are blended by the
 // squared direction components; a sample whose eight texels the level's occupancy map
-// marks empty reads nothing. Texels are RGBA16F (accel/vct/half_rgba.hpp), weighted in
-// SSE2 four channels at a time. Samples are composited front to
+// marks empty reads nothing. Texels are RGBA16F (accel/vct/half_rgba.hpp), weighted four
+// channels at a time (SSE2, or F16C + FMA where the CPU has them: ConeKernel). Samples are composited front to
 // back (eq. 3 on premultiplied colour: c += (1 − α)·c₂, α += (1 − α)·α₂; the paper's
 // "c = αc + …" as printed would scale earlier samples down and lose energy); the step is
 // a fraction of the sampled level's voxel, and optionally the opacity is corrected for
@@ -33,6 +33,14 @@
 #include "core/util/math.hpp"
 
 namespace gilab {
+
+// The instructions a sample is computed with: `portable` (SSE2, every x86-64; scalar
+// elsewhere) or `avx2` (AVX2 + FMA + F16C, chosen at run time where the CPU has them).
+// Both compute the same sums; fused multiply-adds round differently (< 1e-6 relative), so
+// images are bit-identical at any thread count on one machine, not across kernels.
+enum class ConeKernel { portable, avx2 };
+ConeKernel best_cone_kernel();
+const char* to_string(ConeKernel kernel);
 
 // One level of a voxel structure as the cone tracer reads it.
 struct ConeLevel {
@@ -67,7 +75,8 @@ public:
     int level_containing(const Vec3& p, int from, float margin = 1.0f) const;
     // Trilinear, face-weighted sample of one level (position clamped into the level).
     // With a plane (n, d), voxels whose box reaches n·x ≤ d count as empty.
-    Vec4 sample_level(int level, const Vec3& p, const FaceWeights& faces, const Vec4* plane = nullptr) const;
+    Vec4 sample_level(int level, const Vec3& p, const FaceWeights& faces, const Vec4* plane = nullptr,
+                      ConeKernel kernel = best_cone_kernel()) const;
 
 private:
     bool contains(const ConeLevel& l, const Vec3& p, float margin) const {
@@ -129,7 +138,9 @@ inline float cone_level(float diameter, float base_voxel_size) {
     return std::log2(std::max(diameter / base_voxel_size, 1.0f));
 }
 
-ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOptions& options);
+ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOptions& options);  // best kernel
+// With a chosen kernel (Error if this CPU lacks it).
+ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOptions& options, ConeKernel kernel);
 
 // Fixed cones over the hemisphere around +z (P3: 16 cones): equal solid angle 2π/N each
 // (axes on a spiral, uniform in cos θ), half aperture with that solid angle. The weights
