@@ -14,6 +14,9 @@
 //  - BM_SampleLevel: one trilinear face-weighted sample (the inner loop of every cone),
 //    from a one-voxel neighbourhood (cache-resident), scattered over the finest level,
 //    or scattered over every level; with or without the clip plane.
+//  - BM_ReadBandwidth: the machine's read bandwidth (summing 64-bit words) from a buffer
+//    the size of one cascade level's radiance (1.5 MiB: cache) and of 256 MiB (memory),
+//    the bound a cone sampler would meet if it were limited by the bytes it reads.
 // Args name the structure (0 cascaded, 1 dense) and, where given, the worker threads
 // (0: all cores) and the sampling kernel (0 portable SSE2, 1 AVX2 + FMA + F16C; see
 // ConeKernel), so one run gives the kernels' ratio. Set-up (loading, voxelizing, the first injection) happens once per
@@ -390,5 +393,41 @@ BENCHMARK(BM_SampleLevel)
     ->ArgsProduct({{0, 1}, {0, 1, 2}, {0, 1}, {0, 1}})
     ->ArgNames({"structure", "pattern", "plane", "kernel"})
     ->Unit(benchmark::kMicrosecond);
+
+void BM_ReadBandwidth(benchmark::State& state) {
+    const size_t bytes = size_t(state.range(0)) << 10;
+    const int threads = int(state.range(1));
+    ThreadLimit limit(threads);
+    std::vector<uint64_t> buffer(bytes / sizeof(uint64_t));
+    for (size_t i = 0; i < buffer.size(); ++i) buffer[i] = i;
+    // Each task sums its part of the buffer; four independent sums keep the adds off the
+    // critical path, so the loads set the pace.
+    auto pass = [&] {
+        std::atomic<uint64_t> total{0};
+        parallel_for(buffer.size(), buffer.size() / 64 + 1, [&](size_t b, size_t e) {
+            uint64_t s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+            size_t i = b;
+            for (; i + 4 <= e; i += 4) {
+                s0 += buffer[i];
+                s1 += buffer[i + 1];
+                s2 += buffer[i + 2];
+                s3 += buffer[i + 3];
+            }
+            for (; i < e; ++i) s0 += buffer[i];
+            total += s0 + s1 + s2 + s3;
+        });
+        return total.load();
+    };
+    benchmark::DoNotOptimize(pass());  // warm-up: pages touched, caches filled
+    for (auto _ : state) benchmark::DoNotOptimize(pass());
+    state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(bytes));
+    state.SetLabel(std::to_string(bytes >> 10) + " KiB, " +
+                   (threads > 0 ? std::to_string(threads) + " thread(s)" : std::string("all cores")));
+}
+BENCHMARK(BM_ReadBandwidth)
+    ->ArgsProduct({{1536, 256 << 10}, {1, 0}})
+    ->ArgNames({"kib", "threads"})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 
 }  // namespace
