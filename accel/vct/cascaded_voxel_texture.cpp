@@ -37,7 +37,6 @@ CascadedVoxelTexture::CascadedVoxelTexture(const CascadeConfig& config) : config
     slots_.assign(voxel_count(), kEmptySlot);
     pools_.assign(size_t(config_.levels), {});
     freed_.assign(size_t(config_.levels), 0);
-    direct.assign(n, HalfRGBA{});
     radiance.assign(n, HalfRGBA{});
     occupancy_.assign(size_t(config_.levels) * texels_per_level(), 1);
 }
@@ -97,7 +96,7 @@ void CascadedVoxelTexture::place(int level, const IVec3& origin) {
     gilab::parallel_for(size_t(R), 1, [&](size_t z0, size_t z1) {
         for (size_t z = z0; z < z1; ++z) {
             const size_t first = index(0, level, UVec3(0, 0, uint32_t(z))), n = size_t(R) * size_t(R) * kFaceCount;
-            for (auto* a : {&direct, &radiance}) std::fill_n(a->begin() + ptrdiff_t(first), n, HalfRGBA{});
+            std::fill_n(radiance.begin() + ptrdiff_t(first), n, HalfRGBA{});
         }
     });
     std::fill_n(slots_.begin() + ptrdiff_t(size_t(level) * texels_per_level()), texels_per_level(), kEmptySlot);
@@ -165,7 +164,6 @@ void CascadedVoxelTexture::compact_if_sparse(int level) {
 
 void CascadedVoxelTexture::clear_radiance(int level, const VoxelBox& box) {
     for_each_run(level, box, [&](size_t i, size_t n) {
-        std::fill_n(direct.begin() + ptrdiff_t(i), n, HalfRGBA{});
         std::fill_n(radiance.begin() + ptrdiff_t(i), n, HalfRGBA{});
     });
 }
@@ -207,13 +205,7 @@ std::vector<VoxelBox> CascadedVoxelTexture::scroll(int level, const IVec3& new_o
             const bool fill = has_coarser && contains(level + 1, parent);
             for (int f = 0; f < kFaceCount; ++f) {
                 size_t i = index_of_voxel(f, level, v);
-                if (fill) {
-                    size_t j = index_of_voxel(f, level + 1, parent);
-                    direct[i] = direct[j];
-                    radiance[i] = radiance[j];
-                } else {
-                    direct[i] = radiance[i] = HalfRGBA{};
-                }
+                radiance[i] = fill ? radiance[index_of_voxel(f, level + 1, parent)] : HalfRGBA{};
             }
         });
     }
@@ -394,7 +386,7 @@ size_t CascadedVoxelTexture::occupancy_encoding_bytes() const {
 }
 
 size_t CascadedVoxelTexture::radiance_bytes() const {
-    return (direct.size() + radiance.size()) * sizeof(HalfRGBA) + occupancy_.size();
+    return radiance.size() * sizeof(HalfRGBA) + occupancy_.size();
 }
 
 }  // namespace gilab

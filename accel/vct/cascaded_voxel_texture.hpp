@@ -96,7 +96,7 @@ public:
     // slots; a pool holding more freed entries than live ones is compacted.
     static constexpr uint32_t kEmptySlot = 0xFFFFFFFFu;
     void clear_gbuffer(int level, const VoxelBox& box);         // box ∩ region
-    void clear_radiance(int level, const VoxelBox& box);        // both radiance buffers
+    void clear_radiance(int level, const VoxelBox& box);
     // Not thread-safe (the voxelize calls serialise their voxelizer's writes).
     void write(int level, const AnisotropicVoxel& voxel);       // must lie in the region
     // The G-buffer voxel at world voxel v of the level, or nullptr (empty or outside).
@@ -126,33 +126,32 @@ public:
     std::vector<IVec3> occupied_in(int level, const VoxelBox& box) const;
 
     // ---- anisotropic filtering: the inner box of `level` from level − 1 (2×2×2 → 1 per
-    // face, front-to-back along the face's axis) in one of the radiance buffers.
+    // face, front-to-back along the face's axis) in a radiance buffer laid out as `radiance`.
     void downsample(int level, std::vector<HalfRGBA>& buffer) const;
 
     // ---- occupancy for cone marching: per level and texel t, whether any face of the
     // 2×2×2 texels from t up (toroidally) has opacity in `buffer` — the texels one
     // trilinear sample reads. A sample whose byte is 0 reads nothing and is skipped.
-    // Starts all 1 (nothing skipped) and is exact after a refresh. Both radiance buffers
-    // carry the same opacity, so one map serves both.
+    // Starts all 1 (nothing skipped) and is exact after a refresh.
     void refresh_occupancy(int level, const std::vector<HalfRGBA>& buffer);
     const uint8_t* occupancy(int level) const { return occupancy_.data() + size_t(level) * texels_per_level(); }
 
     // ---- memory
     size_t voxel_count() const { return size_t(config_.levels) * texels_per_level(); }
     size_t gbuffer_bytes() const;   // slots and pools (their capacity)
-    size_t radiance_bytes() const;  // both radiance buffers and the occupancy map
+    size_t radiance_bytes() const;  // the radiance buffer and the occupancy map
     // What encodes occupancy alone: the slots and the pools' float opacities.
     size_t occupancy_encoding_bytes() const;
     size_t bytes() const { return gbuffer_bytes() + radiance_bytes(); }
     // What the paper's Tables 5/6 count: opacity only, one byte per voxel per face.
     size_t opacity_bytes_paper() const { return voxel_count() * size_t(kFaceCount); }
 
-    // Radiance (V-buffer), one allocation each, premultiplied RGBA16F with alpha the
-    // opacity: `direct` (direct light only) and `radiance` (direct + voxel bounce), both
-    // anisotropically filtered from finer levels. (The G-buffer keeps what the light
-    // injection reads; emitters are lit by shadow rays, not injected, so the voxelizer's
-    // emission is not kept.)
-    std::vector<HalfRGBA> direct, radiance;
+    // Radiance (V-buffer), one allocation: premultiplied RGBA16F with alpha the opacity.
+    // The injection writes a level's direct light here, gathers the voxel bounce from
+    // it, then overwrites it with direct + bounce, which the pixels' cones read
+    // (vct_technique.cpp). The G-buffer keeps what the injection reads; emitters are lit
+    // by shadow rays, not injected, so the voxelizer's emission is not kept.
+    std::vector<HalfRGBA> radiance;
 
 private:
     template <class Fn>

@@ -16,7 +16,7 @@ namespace {
 double buffer_bytes(int resolution) {
     double cells = 0;
     for (int r = resolution; r >= 1; r >>= 1) cells += double(kFaceCount) * double(r) * r * r;
-    return 2.0 * cells * double(sizeof(HalfRGBA));  // direct + radiance
+    return cells * double(sizeof(HalfRGBA));
 }
 
 }  // namespace
@@ -39,11 +39,9 @@ void DenseMipConfig::validate() const {
 DenseMipTexture::DenseMipTexture(const DenseMipConfig& config) : config_(config) {
     config_.validate();
     const int levels = std::countr_zero(unsigned(config_.resolution)) + 1;
-    direct.resize(size_t(levels));
     radiance.resize(size_t(levels));
     occupancy_.resize(size_t(levels));
     for (int k = 0; k < levels; ++k) {
-        direct[size_t(k)].assign(cells(k), HalfRGBA{});
         radiance[size_t(k)].assign(cells(k), HalfRGBA{});
         occupancy_[size_t(k)].assign(cells(k) / kFaceCount, 1);
     }
@@ -97,7 +95,6 @@ void DenseMipTexture::refresh_occupancy(const std::vector<std::vector<HalfRGBA>>
 
 size_t DenseMipTexture::radiance_bytes() const {
     size_t bytes = 0;
-    for (const auto& l : direct) bytes += l.size() * sizeof(HalfRGBA);
     for (const auto& l : radiance) bytes += l.size() * sizeof(HalfRGBA);
     for (const auto& l : occupancy_) bytes += l.size();
     return bytes;

@@ -24,7 +24,7 @@ struct DenseMipConfig {
     int resolution = 128;      // level-0 voxels per axis, a power of two
     double voxel_size = 1.0;   // of level 0
     DVec3 anchor{0};           // world position of voxel (0,0,0)'s minimum corner
-    size_t max_bytes = size_t(4) << 30;  // both radiance buffers with their mips
+    size_t max_bytes = size_t(4) << 30;  // the radiance buffer with its mips
     void validate() const;     // throws Error naming the bad field (and the memory it would need)
 };
 
@@ -34,7 +34,7 @@ public:
     explicit DenseMipTexture(const DenseMipConfig& config);
 
     const DenseMipConfig& config() const { return config_; }
-    int level_count() const { return int(direct.size()); }
+    int level_count() const { return int(radiance.size()); }
     int resolution(int level) const { return config_.resolution >> level; }
     double voxel_size(int level) const { return std::ldexp(config_.voxel_size, level); }
     VoxelLattice lattice() const { return {config_.anchor, config_.voxel_size}; }
@@ -56,18 +56,19 @@ public:
     void build_mips(std::vector<std::vector<HalfRGBA>>& buffer) const;
     // Per level and texel t: whether any face of the 2×2×2 texels from t up has opacity
     // in `buffer` (what one trilinear sample reads; 0: the sample is skipped). All 1
-    // until the first refresh; both buffers carry the same opacity.
+    // until the first refresh.
     void refresh_occupancy(const std::vector<std::vector<HalfRGBA>>& buffer);
     const uint8_t* occupancy(int level) const { return occupancy_[size_t(level)].data(); }
 
     size_t voxel_count() const { return size_t(config_.resolution) * config_.resolution * config_.resolution; }
-    size_t radiance_bytes() const;  // both radiance buffers and the occupancy maps
+    size_t radiance_bytes() const;  // the radiance buffer and the occupancy maps
     size_t gbuffer_bytes() const { return voxels.capacity() * sizeof(PackedVoxel); }
     size_t bytes() const { return radiance_bytes() + gbuffer_bytes(); }
 
     std::vector<PackedVoxel> voxels;            // sparse G-buffer, (z, y, x) order
-    std::vector<std::vector<HalfRGBA>> direct;      // per level, premultiplied RGBA16F
-    std::vector<std::vector<HalfRGBA>> radiance;    // per level, direct + voxel bounce
+    // Per level, premultiplied RGBA16F: the injection writes direct light, gathers the
+    // voxel bounce from it, then overwrites it with direct + bounce (as the cascades).
+    std::vector<std::vector<HalfRGBA>> radiance;
 
 private:
     DenseMipConfig config_;

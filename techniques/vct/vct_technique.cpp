@@ -458,18 +458,28 @@ void VctTechnique::light_cascade(const std::vector<bool>& levels) {
     std::vector<std::vector<VoxelRadiance>> own_direct(size_t(t.levels()));
 
     // The anisotropic filter of one level, timed and counted (cells written).
-    auto filter = [&](int k, std::vector<HalfRGBA>& buffer) {
+    auto filter = [&](int k) {
         Stopwatch watch;
-        t.downsample(k, buffer);
+        t.downsample(k, t.radiance);
         filter_ms += watch.elapsed_ms();
         filter_cells += uint64_t(t.inner_box(k).volume()) * kFaceCount;
     };
+    // A level's own voxels take new values (one per voxel, six faces), then the level
+    // is filtered from the finer one (levels in increasing order).
+    auto write_own = [&](int k, const std::vector<VoxelRadiance>& values) {
+        clear_own(k, t.radiance);
+        const auto& list = own[size_t(k)];
+        for (size_t i = 0; i < list.size(); ++i) {
+            const size_t first = t.index_of_voxel(0, k, list[i]);
+            for (int f = 0; f < kFaceCount; ++f) t.radiance[first + size_t(f)] = to_half_rgba(values[i][size_t(f)]);
+        }
+        filter(k);
+    };
 
-    // Direct light, then filtered into the coarser levels.
+    // Direct light by shadow rays.
     for (int k = 0; k < t.levels(); ++k) {
         if (!levels[size_t(k)]) continue;
         Stopwatch watch;
-        clear_own(k, t.direct);
         const auto& list = own[size_t(k)];
         auto& values = own_direct[size_t(k)];
         values.resize(list.size());
@@ -478,59 +488,50 @@ void VctTechnique::light_cascade(const std::vector<bool>& levels) {
             uint64_t local = 0;
             shading.direct(e - b, k, voxel, [&](size_t i) { return std::pair(input_of(t, k, list[b + i]), list[b + i]); },
                            values.data() + b, local);
-            for (size_t i = b; i < e; ++i) {
-                const size_t first = t.index_of_voxel(0, k, list[i]);
-                for (int f = 0; f < kFaceCount; ++f) t.direct[first + size_t(f)] = to_half_rgba(values[i][size_t(f)]);
-            }
             faces_lit += local;
         });
         lit += list.size();
         direct_ms += watch.elapsed_ms();
-        filter(k, t.direct);
     }
-    // Cones skip what holds no opacity (the same in both buffers).
-    for (int k = 0; k < t.levels(); ++k)
-        if (levels[size_t(k)]) t.refresh_occupancy(k, t.direct);
-    // Voxel bounce from the direct V-buffer — or, with temporal bounces, from the radiance
-    // of the frames before (then every level gathers before any is rewritten).
+    // The V-buffer the bounce gathers from: this frame's direct light in the updated
+    // levels (the other levels keep direct + bounce of their last update, as one
+    // radiance texture on a GPU does) — or, with temporal bounces, the radiance of the
+    // frames before everywhere.
     const bool temporal = settings_.temporal_bounces;
+    if (!temporal)
+        for (int k = 0; k < t.levels(); ++k)
+            if (levels[size_t(k)]) write_own(k, own_direct[size_t(k)]);
+    // Cones skip what holds no opacity.
+    for (int k = 0; k < t.levels(); ++k)
+        if (levels[size_t(k)] || temporal) t.refresh_occupancy(k, t.radiance);
+    if (!settings_.second_bounce) {
+        if (temporal)
+            for (int k = 0; k < t.levels(); ++k)
+                if (levels[size_t(k)]) write_own(k, own_direct[size_t(k)]);
+    } else {
+        // Every updated level gathers before any is rewritten with direct + bounce.
+        const VoxelConeView view = VoxelConeView::cascade(t, t.radiance);
+        std::vector<std::vector<VoxelRadiance>> bounced(size_t(t.levels()));
+        for (int k = 0; k < t.levels(); ++k) {
+            if (!levels[size_t(k)]) continue;
+            Stopwatch watch;
+            const auto& list = own[size_t(k)];
+            const auto& values = own_direct[size_t(k)];
+            auto& out = bounced[size_t(k)];
+            out.resize(list.size());
+            const float voxel = float(t.voxel_size(k));
+            parallel_for(list.size(), 4, [&](size_t b, size_t e) {
+                uint64_t local = 0;
+                for (size_t i = b; i < e; ++i) out[i] = shading.bounce(input_of(t, k, list[i]), values[i], view, voxel, local);
+                cones += local;
+            });
+            bounce_ms += watch.elapsed_ms();
+        }
+        for (int k = 0; k < t.levels(); ++k)
+            if (levels[size_t(k)]) write_own(k, bounced[size_t(k)]);
+    }
     if (temporal)
         for (int k = 0; k < t.levels(); ++k) t.refresh_occupancy(k, t.radiance);
-    const VoxelConeView view = VoxelConeView::cascade(t, temporal ? t.radiance : t.direct);
-    std::vector<std::vector<VoxelRadiance>> bounced(size_t(t.levels()));
-    auto write_radiance = [&](int k) {
-        clear_own(k, t.radiance);
-        const auto& list = own[size_t(k)];
-        for (size_t i = 0; i < list.size(); ++i) {
-            const size_t first = t.index_of_voxel(0, k, list[i]);
-            for (int f = 0; f < kFaceCount; ++f)
-                t.radiance[first + size_t(f)] = to_half_rgba(bounced[size_t(k)][i][size_t(f)]);
-        }
-        filter(k, t.radiance);
-    };
-    for (int k = 0; k < t.levels(); ++k) {
-        if (!levels[size_t(k)]) continue;
-        Stopwatch watch;
-        const auto& list = own[size_t(k)];
-        const auto& values = own_direct[size_t(k)];
-        auto& out = bounced[size_t(k)];
-        out.resize(list.size());
-        const float voxel = float(t.voxel_size(k));
-        parallel_for(list.size(), 4, [&](size_t b, size_t e) {
-            uint64_t local = 0;
-            for (size_t i = b; i < e; ++i)
-                out[i] = settings_.second_bounce ? shading.bounce(input_of(t, k, list[i]), values[i], view, voxel, local)
-                                                 : values[i];
-            cones += local;
-        });
-        bounce_ms += watch.elapsed_ms();
-        if (!temporal) write_radiance(k);
-    }
-    if (temporal) {
-        for (int k = 0; k < t.levels(); ++k)
-            if (levels[size_t(k)]) write_radiance(k);
-        for (int k = 0; k < t.levels(); ++k) t.refresh_occupancy(k, t.radiance);
-    }
     stats_.add("injection_cones_traced", double(cones.load() & 0xffffffffu));
     stats_.add("injection_cone_samples", double(cones.load() >> 32));
     stats_.set("voxels_lit", double(lit.load()));
@@ -547,52 +548,53 @@ void VctTechnique::light_dense() {
     const float voxel = float(t.voxel_size(0));
     const auto& list = t.voxels;
     std::atomic<uint64_t> faces_lit{0};
-    double filter_ms = 0;
+    double filter_ms = 0, bounce_ms = 0;
+    int mip_builds = 0;
     Stopwatch watch;
-    DenseMipTexture::clear_level0(t.direct);
     std::vector<VoxelRadiance> values(list.size());  // full precision, for the bounce
     parallel_blocks(list.size(), kInjectionBlock, [&](size_t b, size_t e) {
         uint64_t local = 0;
         shading.direct(e - b, 0, voxel, [&](size_t i) { return std::pair(input_of(list[b + i], t.lattice()), list[b + i].coord); },
                        values.data() + b, local);
-        for (size_t i = b; i < e; ++i) {
-            const size_t first = t.index(0, 0, list[i].coord);
-            for (int f = 0; f < kFaceCount; ++f) t.direct[0][first + size_t(f)] = to_half_rgba(values[i][size_t(f)]);
-        }
         faces_lit += local;
     });
     const double direct_ms = watch.elapsed_ms();
-    watch.reset();
-    t.build_mips(t.direct);
-    t.refresh_occupancy(t.direct);  // cones skip what holds no opacity (the same in both buffers)
-    filter_ms += watch.elapsed_ms();
-    watch.reset();
-    // From the direct V-buffer, or with temporal bounces from the frames before.
+    // Level 0 takes one value per voxel (six faces), then the mips are filtered from it.
+    auto write_level0 = [&](const std::vector<VoxelRadiance>& radiance) {
+        Stopwatch filter_watch;
+        DenseMipTexture::clear_level0(t.radiance);
+        for (size_t i = 0; i < list.size(); ++i) {
+            const size_t first = t.index(0, 0, list[i].coord);
+            for (int f = 0; f < kFaceCount; ++f) t.radiance[0][first + size_t(f)] = to_half_rgba(radiance[i][size_t(f)]);
+        }
+        t.build_mips(t.radiance);
+        filter_ms += filter_watch.elapsed_ms();
+        ++mip_builds;
+    };
+    // The bounce gathers from this frame's direct light — or, with temporal bounces, from
+    // the radiance of the frames before, still in the buffer.
     const bool temporal = settings_.temporal_bounces;
-    if (temporal) t.refresh_occupancy(t.radiance);
-    const VoxelConeView view = VoxelConeView::dense(t, temporal ? t.radiance : t.direct);
-    std::atomic<uint64_t> cones{0};
-    std::vector<VoxelRadiance> bounced(list.size());
-    parallel_for(list.size(), 4, [&](size_t b, size_t e) {
-        uint64_t local = 0;
-        for (size_t i = b; i < e; ++i)
-            bounced[i] = settings_.second_bounce
-                             ? shading.bounce(input_of(list[i], t.lattice()), values[i], view, voxel, local)
-                             : values[i];
-        cones += local;
-    });
-    DenseMipTexture::clear_level0(t.radiance);
-    for (size_t i = 0; i < list.size(); ++i) {
-        const size_t first = t.index(0, 0, list[i].coord);
-        for (int f = 0; f < kFaceCount; ++f) t.radiance[0][first + size_t(f)] = to_half_rgba(bounced[i][size_t(f)]);
-    }
-    const double bounce_ms = watch.elapsed_ms();
+    if (!temporal) write_level0(values);
+    t.refresh_occupancy(t.radiance);  // cones skip what holds no opacity
     watch.reset();
-    t.build_mips(t.radiance);
+    std::atomic<uint64_t> cones{0};
+    if (settings_.second_bounce) {
+        const VoxelConeView view = VoxelConeView::dense(t, t.radiance);
+        std::vector<VoxelRadiance> bounced(list.size());
+        parallel_for(list.size(), 4, [&](size_t b, size_t e) {
+            uint64_t local = 0;
+            for (size_t i = b; i < e; ++i)
+                bounced[i] = shading.bounce(input_of(list[i], t.lattice()), values[i], view, voxel, local);
+            cones += local;
+        });
+        bounce_ms = watch.elapsed_ms();
+        write_level0(bounced);
+    } else if (temporal) {
+        write_level0(values);
+    }
     if (temporal) t.refresh_occupancy(t.radiance);
-    filter_ms += watch.elapsed_ms();
     uint64_t filter_cells = 0;
-    for (int k = 1; k < t.level_count(); ++k) filter_cells += 2 * uint64_t(t.cells(k));
+    for (int k = 1; k < t.level_count(); ++k) filter_cells += uint64_t(mip_builds) * uint64_t(t.cells(k));
     stats_.add("injection_cones_traced", double(cones.load() & 0xffffffffu));
     stats_.add("injection_cone_samples", double(cones.load() >> 32));
     stats_.set("voxels_lit", double(list.size()));

@@ -12,9 +12,11 @@
 //  2. injection— direct light into the V-buffer of every updated level (Embree shadow
 //                rays from each voxel face), anisotropic filtering finer → coarser, then
 //                the voxel bounce: 16 fixed cones per side of the voxel (its faces whose
-//                normals agree) over the hemisphere of its mean normal gather the direct
-//                V-buffer; radiance = direct +
-//                albedo/π·Σ; filtered again. Pixels then see two indirect bounces
+//                normals agree) over the hemisphere of its mean normal gather the
+//                V-buffer; radiance = direct + albedo/π·Σ overwrites it and is
+//                filtered again (one V-buffer, as P3's one radiance texture: levels
+//                the update strategy skips this frame hold direct + bounce of their
+//                last update while the others gather). Pixels then see two indirect bounces
 //                (temporal_bounces: the voxel bounce gathers the frames before's
 //                radiance instead, one bounce more every frame).
 //  3. shading  — primary visibility and direct lighting are ray traced by Embree (the
@@ -106,7 +108,7 @@ public:
     // Step 1 and 2 of a frame for a viewer position (render() calls it); advances the
     // frame counter. Timings go to stats "update_ms" (of which "revoxelize_ms") and
     // "injection_ms" (of which "injection_direct_ms", "injection_bounce_ms" and
-    // "filter_ms", the anisotropic filtering of both radiance buffers).
+    // "filter_ms", the anisotropic filtering after the direct light and after the bounce).
     void update_voxels(const Vec3& viewer);
     // The view of the final radiance buffer the pixels gather from.
     VoxelConeView radiance_view() const;

@@ -301,17 +301,17 @@ TEST(CascadedVoxelTexture, DownsampleFillsTheInnerBoxFromTheFinerLevel) {
         t.place(k, t.origin_for(DVec3(0.0), k));
         t.voxelize(k, vox);
     }
-    for (size_t i = 0; i < t.cell_count(); ++i) t.direct[i] = to_half_rgba(Vec4(Vec3(2.0f * t.opacity_of_cell(i)), t.opacity_of_cell(i)));
-    t.downsample(1, t.direct);
+    for (size_t i = 0; i < t.cell_count(); ++i) t.radiance[i] = to_half_rgba(Vec4(Vec3(2.0f * t.opacity_of_cell(i)), t.opacity_of_cell(i)));
+    t.downsample(1, t.radiance);
     const VoxelBox inner = t.inner_box(1);
     ASSERT_FALSE(inner.empty());
     // Level-1 voxel column holding x = 0.3 (voxel size 0.5 → x index 0); level 0 covers
     // it with children x = 0, 1 (size 0.25), the wall in child 1.
     for (int y = inner.begin.y; y < inner.end.y; ++y) {
-        Vec4 v = from_half_rgba(t.direct[t.index_of_voxel(kFaceNegX, 1, IVec3(0, y, 0))]);
+        Vec4 v = from_half_rgba(t.radiance[t.index_of_voxel(kFaceNegX, 1, IVec3(0, y, 0))]);
         EXPECT_NEAR(v.a, 1.0f, 1e-3f);
         EXPECT_NEAR(v.r, 2.0f, 2e-3f);
-        Vec4 side = from_half_rgba(t.direct[t.index_of_voxel(kFacePosY, 1, IVec3(0, y, 0))]);
+        Vec4 side = from_half_rgba(t.radiance[t.index_of_voxel(kFacePosY, 1, IVec3(0, y, 0))]);
         EXPECT_EQ(side.a, 0.0f);
     }
 }
@@ -346,10 +346,10 @@ TEST(DenseMipTexture, MipChainAndMemoryBudget) {
     EXPECT_EQ(t.resolution(3), 1);
     // One opaque voxel with radiance 1 on all faces: each mip level sees it as 1/4 of a
     // column per face, composited opaque in front → alpha 1/4 per level.
-    for (int f = 0; f < kFaceCount; ++f) t.direct[0][t.index(0, f, IVec3(0))] = to_half_rgba(Vec4(1, 1, 1, 1));
-    t.build_mips(t.direct);
-    EXPECT_FLOAT_EQ(from_half_rgba(t.direct[1][t.index(1, kFacePosX, IVec3(0))]).a, 0.25f);
-    EXPECT_FLOAT_EQ(from_half_rgba(t.direct[2][t.index(2, kFacePosX, IVec3(0))]).a, 0.0625f);
+    for (int f = 0; f < kFaceCount; ++f) t.radiance[0][t.index(0, f, IVec3(0))] = to_half_rgba(Vec4(1, 1, 1, 1));
+    t.build_mips(t.radiance);
+    EXPECT_FLOAT_EQ(from_half_rgba(t.radiance[1][t.index(1, kFacePosX, IVec3(0))]).a, 0.25f);
+    EXPECT_FLOAT_EQ(from_half_rgba(t.radiance[2][t.index(2, kFacePosX, IVec3(0))]).a, 0.0625f);
     config.resolution = 512;
     config.max_bytes = size_t(1) << 30;
     try {
