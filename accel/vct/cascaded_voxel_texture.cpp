@@ -147,7 +147,11 @@ void CascadedVoxelTexture::clear_gbuffer(int level, const VoxelBox& box) {
 
 void CascadedVoxelTexture::compact_if_sparse(int level) {
     std::vector<PackedVoxel>& pool = pools_[size_t(level)];
-    if (freed_[size_t(level)] * 2 <= pool.size()) return;
+    if (freed_[size_t(level)] * 2 <= pool.size()) {
+        // Growing by doubling can leave half the capacity unused: the level keeps what it holds.
+        if (pool.capacity() > pool.size() + pool.size() / 8) pool.shrink_to_fit();
+        return;
+    }
     // Live entries in (z, y, x) order of the region, which also keeps the result
     // independent of the order the voxelizer's threads wrote them in.
     std::vector<PackedVoxel> live;

@@ -164,7 +164,7 @@ private:
     // Voxelizes `boxes` minus `exclude` into the level with the writes serialised.
     FragmentVoxelizeStats voxelize_boxes(int level, const FragmentVoxelizer& voxelizer,
                                          const std::vector<VoxelBox>& boxes, const VoxelBox& exclude);
-    void compact_if_sparse(int level);
+    void compact_if_sparse(int level);  // and trims unused pool capacity
     void store(int level, const PackedVoxel& voxel);  // voxel.coord inside the region
     CascadeConfig config_;
     std::vector<IVec3> origins_;

@@ -356,9 +356,9 @@ void register_camera_walks(ExperimentRegistry& registry) {
         .axes = {kDenseResolution},
         .reducer = "vct-fig10",
         .notes = {walk_note(),
-                  "Structure memory = every attribute array the technique holds (dense: both radiance mip chains as "
-                  "RGBA16F × 6 faces, their occupancy bytes and the sparse G-buffer list; cascaded: two radiance "
-                  "buffers of 6 × 32³ × 6 faces RGBA16F, their occupancy bytes and the sparse G-buffer — a slot per "
+                  "Structure memory = every attribute array the technique holds (dense: the radiance mip chain as "
+                  "RGBA16F × 6 faces, its occupancy bytes and the sparse G-buffer list; cascaded: the radiance "
+                  "buffer of 6 × 32³ × 6 faces RGBA16F, its occupancy bytes and the sparse G-buffer — a slot per "
                   "texel and the occupied voxels; photon mapping: the hash-grid photon map; LPV: per cascade its four SH volumes, geometry "
                   "volume and face transmittances, and the frame's VPLs and surfels). Process RSS is the whole process "
                   "after each frame of the last variant. The paper reports whole-application memory (cascaded ≈ 40 % "

@@ -428,7 +428,7 @@ std::vector<std::string> structure_notes(std::vector<std::string> more) {
         "Memory: each structure charged its real encoding of occupancy (column 'encoding'): the 3D texture 1 B per "
         "cell; SVO, SVDAG, MSVO and OpenVDB exactly what our build holds; the cascades their G-buffer slots and the float "
         "opacity per face of their occupied voxels (the paper counts 1 B per face: 6 B per cell). 'all arrays held' adds, for the cascades, every G-buffer "
-        "attribute and both radiance buffers. The paper's MB are 2²⁰ B (its 3D texture at 128³, 2 097 152 B, is "
+        "attribute and the radiance buffer. The paper's MB are 2²⁰ B (its 3D texture at 128³, 2 097 152 B, is "
         "printed as 2 MB), ours 10⁶ B; its bytes per node are implied by dividing its memory by its own count."};
     notes.insert(notes.end(), more.begin(), more.end());
     return notes;
