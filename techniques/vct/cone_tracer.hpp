@@ -36,8 +36,9 @@ namespace gilab {
 
 // The instructions a sample is computed with: `portable` (SSE2, every x86-64; scalar
 // elsewhere) or `avx2` (AVX2 + FMA + F16C, chosen at run time where the CPU has them).
-// Both compute the same sums; fused multiply-adds round differently (< 1e-6 relative), so
-// images are bit-identical at any thread count on one machine, not across kernels.
+// Both compute the same sums, in another order and with fused multiply-adds, so they
+// round differently (about 1e-6 relative): images are bit-identical at any thread count
+// on one machine, not across kernels.
 enum class ConeKernel { portable, avx2 };
 ConeKernel best_cone_kernel();
 const char* to_string(ConeKernel kernel);
