@@ -119,32 +119,45 @@ struct SampleCorners {
     return (c.weight[2][k >> 2] * c.weight[1][(k >> 1) & 1]) * c.weight[0][k & 1];
 }
 
-// The clip plane's mask: keep[f][k] is 0 where face f of texel k is skipped. Voxels
-// entirely behind the plane are empty; voxels it cuts hold the cone's own surface, so
-// their faces turned away from the plane (the surface's back side, seen only through the
-// wide trilinear footprint of a coarse level) are skipped.
+// The clip plane's rule: voxels entirely behind the plane are empty; voxels it cuts hold
+// the cone's own surface, so their faces turned away from the plane (the surface's back
+// side, seen only through the wide trilinear footprint of a coarse level) are skipped.
+// Texel k's signed distance is s[0][k & 1] + s[1][(k >> 1) & 1] + s[2][k >> 2] − plane.w;
+// behind: distance + half ≤ 0, cut: distance − half ≤ 0, with `half` a hair more than
+// half a voxel along n, so a surface lying on a voxel face counts as cut.
+struct ClipGeometry {
+    float s[3][2];  // n[a] × the voxel centre's coordinate a, for the lower and upper voxel
+    float half;
+};
+[[gnu::always_inline]] inline ClipGeometry clip_geometry(const ConeLevel& l, const Vec3& anchor, const SampleCorners& c,
+                                                         const Vec4& plane) {
+    ClipGeometry g;
+    const Vec3 n(plane);
+    g.half = 0.501f * l.voxel_size * (std::abs(n.x) + std::abs(n.y) + std::abs(n.z));
+    const IVec3 i[2] = {c.i0, c.i1};
+    for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 2; ++b) g.s[a][b] = n[a] * (anchor[a] + (float(i[b][a]) + 0.5f) * l.voxel_size);
+    return g;
+}
+// Whether a face (2a looks along +a, 2a + 1 along −a: anisotropic_voxel.hpp) is turned
+// towards the plane's front side.
+[[gnu::always_inline]] inline bool faces_plane_front(int face, const Vec4& plane) {
+    const float along = plane[face >> 1];
+    return ((face & 1) ? -along : along) >= -1e-6f;
+}
+
+// keep[f][k] is 0 where face f of texel k is skipped by the clip plane.
 [[gnu::always_inline]] inline void clip_mask(const ConeLevel& l, const Vec3& anchor, const SampleCorners& c,
                                              const FaceWeights& faces, const Vec4& plane, float (*keep)[8]) {
     float keep_back[8] = {1, 1, 1, 1, 1, 1, 1, 1}, keep_front[8] = {1, 1, 1, 1, 1, 1, 1, 1};
-    const Vec3 n(plane);
-    // A hair more than half a voxel, so a surface lying on a voxel face counts as cut.
-    const float half = 0.501f * l.voxel_size * (std::abs(n.x) + std::abs(n.y) + std::abs(n.z));
-    const IVec3 i[2] = {c.i0, c.i1};
-    float sx[2], sy[2], sz[2];
-    for (int k = 0; k < 2; ++k) {
-        sx[k] = n.x * (anchor.x + (float(i[k].x) + 0.5f) * l.voxel_size);
-        sy[k] = n.y * (anchor.y + (float(i[k].y) + 0.5f) * l.voxel_size);
-        sz[k] = n.z * (anchor.z + (float(i[k].z) + 0.5f) * l.voxel_size);
-    }
+    const ClipGeometry g = clip_geometry(l, anchor, c, plane);
     for (int k = 0; k < 8; ++k) {
-        const float s = sx[k & 1] + sy[(k >> 1) & 1] + sz[k >> 2] - plane.w;
-        if (s + half <= 0.0f) keep_back[k] = keep_front[k] = 0.0f;  // behind
-        else if (s - half <= 0.0f) keep_back[k] = 0.0f;              // cut
+        const float d = g.s[0][k & 1] + g.s[1][(k >> 1) & 1] + g.s[2][k >> 2] - plane.w;
+        if (d + g.half <= 0.0f) keep_back[k] = keep_front[k] = 0.0f;  // behind
+        else if (d - g.half <= 0.0f) keep_back[k] = 0.0f;              // cut
     }
-    for (int f = 0; f < 3; ++f) {
-        const bool front = glm::dot(face_direction(faces.face[size_t(f)]), n) >= -1e-6f;
-        std::copy_n(front ? keep_front : keep_back, 8, keep[f]);
-    }
+    for (int f = 0; f < 3; ++f)
+        std::copy_n(faces_plane_front(faces.face[size_t(f)], plane) ? keep_front : keep_back, 8, keep[f]);
 }
 
 // ---- portable kernel: SSE2 (every x86-64) or scalar.
@@ -216,45 +229,45 @@ template <bool kClip>
 // ---- AVX2 kernel: the eight texel weights and the clip plane's mask in one 8-wide
 // register each; F16C converts a texel's four halves in one instruction and FMA folds the
 // weighting (the same sums as the portable kernel in another order, with fused rounding).
+// Per-axis pairs v[a][0 or 1] spread over the eight texels (texel k takes bit 0 of k
+// along x, bit 1 along y, bit 2 along z, as texel_offset).
+struct Texels8 {
+    __m256 x, y, z;
+};
+__attribute__((target("avx2,fma,f16c"), always_inline)) inline Texels8 spread(const float (&v)[3][2]) {
+    return {_mm256_setr_ps(v[0][0], v[0][1], v[0][0], v[0][1], v[0][0], v[0][1], v[0][0], v[0][1]),
+            _mm256_setr_ps(v[1][0], v[1][0], v[1][1], v[1][1], v[1][0], v[1][0], v[1][1], v[1][1]),
+            _mm256_setr_ps(v[2][0], v[2][0], v[2][0], v[2][0], v[2][1], v[2][1], v[2][1], v[2][1])};
+}
+// texel_weight of the eight texels, in texel_weight's order of products.
+__attribute__((target("avx2,fma,f16c"), always_inline)) inline __m256 texel_product(const float (&v)[3][2]) {
+    const Texels8 t = spread(v);
+    return _mm256_mul_ps(_mm256_mul_ps(t.z, t.y), t.x);
+}
+// clip_mask's sum of the per-axis distances of the eight texels, in its order.
+__attribute__((target("avx2,fma,f16c"), always_inline)) inline __m256 texel_sum(const float (&v)[3][2]) {
+    const Texels8 t = spread(v);
+    return _mm256_add_ps(_mm256_add_ps(t.x, t.y), t.z);
+}
+
 __attribute__((target("avx2,fma,f16c"))) Vec4 sample_avx2(const ConeLevel& l, const Vec3& anchor, const Vec3& p,
                                                           const FaceWeights& faces, const Vec4* plane) {
     const SampleCorners c = corners_of(l, (p - anchor) * l.inv_voxel_size);
     if (l.occupancy && !l.occupancy[c.occupancy]) return Vec4(0.0f);  // all eight texels empty
-    // Texel k = (x: bit 0, y: bit 1, z: bit 2), as texel_offset.
-    const __m256 wx = _mm256_setr_ps(c.weight[0][0], c.weight[0][1], c.weight[0][0], c.weight[0][1], c.weight[0][0],
-                                     c.weight[0][1], c.weight[0][0], c.weight[0][1]);
-    const __m256 wy = _mm256_setr_ps(c.weight[1][0], c.weight[1][0], c.weight[1][1], c.weight[1][1], c.weight[1][0],
-                                     c.weight[1][0], c.weight[1][1], c.weight[1][1]);
-    const __m256 wz = _mm256_setr_ps(c.weight[2][0], c.weight[2][0], c.weight[2][0], c.weight[2][0], c.weight[2][1],
-                                     c.weight[2][1], c.weight[2][1], c.weight[2][1]);
-    const __m256 w = _mm256_mul_ps(_mm256_mul_ps(wz, wy), wx);
+    const __m256 w = texel_product(c.weight);
     alignas(32) float wf[3][8];
     if (!plane) {
         _mm256_store_ps(wf[0], w);
         _mm256_store_ps(wf[1], w);
         _mm256_store_ps(wf[2], w);
     } else {
-        // clip_mask's rule: a voxel whose centre lies more than `half` behind the plane is
-        // empty; one the plane cuts keeps only its faces turned towards the plane's front.
-        const Vec3 n(*plane);
-        const float half = 0.501f * l.voxel_size * (std::abs(n.x) + std::abs(n.y) + std::abs(n.z));
-        float s[3][2];
-        const IVec3 i[2] = {c.i0, c.i1};
-        for (int a = 0; a < 3; ++a)
-            for (int b = 0; b < 2; ++b) s[a][b] = n[a] * (anchor[a] + (float(i[b][a]) + 0.5f) * l.voxel_size);
-        const __m256 sx = _mm256_setr_ps(s[0][0], s[0][1], s[0][0], s[0][1], s[0][0], s[0][1], s[0][0], s[0][1]);
-        const __m256 sy = _mm256_setr_ps(s[1][0], s[1][0], s[1][1], s[1][1], s[1][0], s[1][0], s[1][1], s[1][1]);
-        const __m256 sz = _mm256_setr_ps(s[2][0], s[2][0], s[2][0], s[2][0], s[2][1], s[2][1], s[2][1], s[2][1]);
-        const __m256 d = _mm256_sub_ps(_mm256_add_ps(_mm256_add_ps(sx, sy), sz), _mm256_set1_ps(plane->w));
-        const __m256 h = _mm256_set1_ps(half);
+        // clip_mask's rule, eight texels at once.
+        const ClipGeometry g = clip_geometry(l, anchor, c, *plane);
+        const __m256 d = _mm256_sub_ps(texel_sum(g.s), _mm256_set1_ps(plane->w));
+        const __m256 h = _mm256_set1_ps(g.half);
         const __m256 front = _mm256_and_ps(w, _mm256_cmp_ps(_mm256_add_ps(d, h), _mm256_setzero_ps(), _CMP_GT_OQ));
         const __m256 back = _mm256_and_ps(w, _mm256_cmp_ps(_mm256_sub_ps(d, h), _mm256_setzero_ps(), _CMP_GT_OQ));
-        for (int f = 0; f < 3; ++f) {
-            // Face 2a looks along +a, face 2a + 1 along −a (anisotropic_voxel.hpp).
-            const int face = faces.face[size_t(f)], axis = face >> 1;
-            const float towards = (face & 1) ? -n[axis] : n[axis];
-            _mm256_store_ps(wf[f], towards >= -1e-6f ? front : back);
-        }
+        for (int f = 0; f < 3; ++f) _mm256_store_ps(wf[f], faces_plane_front(faces.face[size_t(f)], *plane) ? front : back);
     }
     const HalfRGBA* face0 = l.data + size_t(faces.face[0]) * l.face_stride;
     const HalfRGBA* face1 = l.data + size_t(faces.face[1]) * l.face_stride;
@@ -386,19 +399,24 @@ Vec4 VoxelConeView::sample_level(int level, const Vec3& p, const FaceWeights& fa
     return sample_portable(l, anchor_, p, faces, plane);
 }
 
-ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOptions& options, ConeKernel kernel) {
+namespace {
+
+ConeResult trace_with(ConeKernel kernel, const VoxelConeView& view, const Cone& cone, const ConeOptions& options) {
 #if GILAB_CONE_AVX2
-    if (kernel == ConeKernel::avx2) {
-        require_supported(kernel);
-        return trace_cone_avx2(view, cone, options);
-    }
+    if (kernel == ConeKernel::avx2) return trace_cone_avx2(view, cone, options);
 #endif
-    require_supported(kernel);
     return trace_cone_portable(view, cone, options);
 }
 
+}  // namespace
+
+ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOptions& options, ConeKernel kernel) {
+    require_supported(kernel);
+    return trace_with(kernel, view, cone, options);
+}
+
 ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOptions& options) {
-    return trace_cone(view, cone, options, best_cone_kernel());
+    return trace_with(best_cone_kernel(), view, cone, options);
 }
 
 ConeSet hemisphere_cones(int count) {

@@ -504,11 +504,7 @@ void VctTechnique::light_cascade(const std::vector<bool>& levels) {
     // Cones skip what holds no opacity.
     for (int k = 0; k < t.levels(); ++k)
         if (levels[size_t(k)] || temporal) t.refresh_occupancy(k, t.radiance);
-    if (!settings_.second_bounce) {
-        if (temporal)
-            for (int k = 0; k < t.levels(); ++k)
-                if (levels[size_t(k)]) write_own(k, own_direct[size_t(k)]);
-    } else {
+    if (settings_.second_bounce) {
         // Every updated level gathers before any is rewritten with direct + bounce.
         const VoxelConeView view = VoxelConeView::cascade(t, t.radiance);
         std::vector<std::vector<VoxelRadiance>> bounced(size_t(t.levels()));
@@ -529,6 +525,9 @@ void VctTechnique::light_cascade(const std::vector<bool>& levels) {
         }
         for (int k = 0; k < t.levels(); ++k)
             if (levels[size_t(k)]) write_own(k, bounced[size_t(k)]);
+    } else if (temporal) {
+        for (int k = 0; k < t.levels(); ++k)
+            if (levels[size_t(k)]) write_own(k, own_direct[size_t(k)]);
     }
     if (temporal)
         for (int k = 0; k < t.levels(); ++k) t.refresh_occupancy(k, t.radiance);
