@@ -20,10 +20,10 @@ void CascadeConfig::validate() const {
         throw Error(where, "voxel size must be positive and finite, got " + std::to_string(voxel_size));
     if (!std::isfinite(anchor.x) || !std::isfinite(anchor.y) || !std::isfinite(anchor.z))
         throw Error(where, "anchor must be finite");
-    // Per cell two RGBA16F radiance values; per texel a G-buffer slot (its pool entry
-    // only when occupied) and an occupancy byte.
+    // Per cell an RGBA16F radiance value; per texel at most three G-buffer records with
+    // their bits, and an occupancy bit.
     double cells = double(levels) * double(resolution) * double(resolution) * double(resolution) * kFaceCount;
-    if (cells * (16.0 + 5.0 / kFaceCount) > double(size_t(8) << 30))
+    if (cells * (8.0 + 37.0 / kFaceCount) > double(size_t(8) << 30))
         throw Error(where, std::to_string(levels) + " levels of " + std::to_string(resolution) +
                                "³ would need more than 8 GiB");
 }
@@ -32,13 +32,9 @@ CascadedVoxelTexture::CascadedVoxelTexture(const CascadeConfig& config) : config
     config_.validate();
     origins_.assign(size_t(config_.levels), IVec3(-config_.resolution / 2));
     own_inner_.assign(size_t(config_.levels), VoxelBox{});
-    gbuffer_clear_.assign(size_t(config_.levels), 1);
-    const size_t n = cell_count();
-    slots_.assign(voxel_count(), kEmptySlot);
-    pools_.assign(size_t(config_.levels), {});
-    freed_.assign(size_t(config_.levels), 0);
-    radiance.assign(n, HalfRGBA{});
-    occupancy_.assign(size_t(config_.levels) * texels_per_level(), 1);
+    gbuffer_.assign(size_t(config_.levels), SparseGBuffer(texels_per_level()));
+    radiance.assign(cell_count(), HalfRGBA{});
+    occupancy_.assign(size_t(config_.levels) * occupancy_words(), ~uint64_t(0));
 }
 
 VoxelBox CascadedVoxelTexture::region(int level) const {
@@ -99,11 +95,8 @@ void CascadedVoxelTexture::place(int level, const IVec3& origin) {
             std::fill_n(radiance.begin() + ptrdiff_t(first), n, HalfRGBA{});
         }
     });
-    std::fill_n(slots_.begin() + ptrdiff_t(size_t(level) * texels_per_level()), texels_per_level(), kEmptySlot);
-    pools_[size_t(level)].clear();
-    freed_[size_t(level)] = 0;
-    std::fill_n(occupancy_.begin() + ptrdiff_t(size_t(level) * texels_per_level()), texels_per_level(), uint8_t(1));
-    gbuffer_clear_[size_t(level)] = true;
+    gbuffer_[size_t(level)].clear();
+    std::fill_n(occupancy_.begin() + ptrdiff_t(size_t(level) * occupancy_words()), occupancy_words(), ~uint64_t(0));
 }
 
 namespace {
@@ -136,34 +129,10 @@ void CascadedVoxelTexture::for_each_run(int level, const VoxelBox& box, Fn&& fn)
 }
 
 void CascadedVoxelTexture::clear_gbuffer(int level, const VoxelBox& box) {
-    if (gbuffer_clear_[size_t(level)]) return;  // nothing written since the level was cleared
-    for_each_voxel(box.intersect(region(level)), [&](const IVec3& v) {
-        uint32_t& slot = slots_[slot_index(level, v)];
-        if (slot == kEmptySlot) return;
-        slot = kEmptySlot;
-        ++freed_[size_t(level)];
-    });
-}
-
-void CascadedVoxelTexture::compact_if_sparse(int level) {
-    std::vector<PackedVoxel>& pool = pools_[size_t(level)];
-    if (freed_[size_t(level)] * 2 <= pool.size()) {
-        // Growing by doubling can leave half the capacity unused: the level keeps what it holds.
-        if (pool.capacity() > pool.size() + pool.size() / 8) pool.shrink_to_fit();
-        return;
-    }
-    // Live entries in (z, y, x) order of the region, which also keeps the result
-    // independent of the order the voxelizer's threads wrote them in.
-    std::vector<PackedVoxel> live;
-    live.reserve(pool.size() - freed_[size_t(level)]);
-    for_each_voxel(region(level), [&](const IVec3& v) {
-        uint32_t& slot = slots_[slot_index(level, v)];
-        if (slot == kEmptySlot) return;
-        live.push_back(pool[slot]);
-        slot = uint32_t(live.size() - 1);
-    });
-    pool = std::move(live);
-    freed_[size_t(level)] = 0;
+    SparseGBuffer& g = gbuffer_[size_t(level)];
+    if (g.records() == 0) return;
+    for_each_voxel(box.intersect(region(level)), [&](const IVec3& v) { g.erase(texel_index(v)); });
+    g.commit();
 }
 
 void CascadedVoxelTexture::clear_radiance(int level, const VoxelBox& box) {
@@ -201,7 +170,7 @@ std::vector<VoxelBox> CascadedVoxelTexture::scroll(int level, const IVec3& new_o
     }
     const bool has_coarser = level + 1 < config_.levels;
     // The exposed texels take new opacity: nothing is skipped until the next refresh.
-    std::fill_n(occupancy_.begin() + ptrdiff_t(size_t(level) * texels_per_level()), texels_per_level(), uint8_t(1));
+    std::fill_n(occupancy_.begin() + ptrdiff_t(size_t(level) * occupancy_words()), occupancy_words(), ~uint64_t(0));
     for (const VoxelBox& box : exposed) {
         clear_gbuffer(level, box);
         for_each_voxel(box, [&](const IVec3& v) {
@@ -219,46 +188,44 @@ std::vector<VoxelBox> CascadedVoxelTexture::scroll(int level, const IVec3& new_o
 void CascadedVoxelTexture::write(int level, const AnisotropicVoxel& voxel) {
     if (!contains(level, voxel.coord))
         throw Error("cascaded voxel texture", "voxel outside level " + std::to_string(level) + "'s region");
-    store(level, pack_voxel(voxel, lattice(level)));
+    SparseGBuffer& g = gbuffer_[size_t(level)];
+    g.stage(texel_index(voxel.coord), pack_voxel(voxel, lattice(level)));
+    g.commit();
 }
 
-void CascadedVoxelTexture::store(int level, const PackedVoxel& voxel) {
-    gbuffer_clear_[size_t(level)] = false;
-    std::vector<PackedVoxel>& pool = pools_[size_t(level)];
-    uint32_t& slot = slots_[slot_index(level, voxel.coord)];
-    if (slot == kEmptySlot) {
-        if (pool.size() >= kEmptySlot) throw Error("cascaded voxel texture", "G-buffer pool full");
-        slot = uint32_t(pool.size());
-        pool.push_back(voxel);
-    } else {
-        pool[slot] = voxel;
-    }
-}
-
-const PackedVoxel* CascadedVoxelTexture::gbuffer_voxel(int level, const IVec3& v) const {
+const PackedSurface* CascadedVoxelTexture::gbuffer_axis(int level, const IVec3& v, int axis) const {
     if (!contains(level, v)) return nullptr;
-    const uint32_t slot = slots_[slot_index(level, v)];
-    return slot == kEmptySlot ? nullptr : &pools_[size_t(level)][slot];
+    return gbuffer_[size_t(level)].find(texel_index(v), axis);
+}
+
+PackedVoxel CascadedVoxelTexture::gbuffer_voxel(int level, const IVec3& v) const {
+    PackedVoxel p;
+    for (int axis = 0; axis < 3; ++axis)
+        if (const PackedSurface* s = gbuffer_axis(level, v, axis)) p.axis[size_t(axis)] = *s;
+    return p;
 }
 
 float CascadedVoxelTexture::opacity_of_cell(size_t cell) const {
-    const uint32_t slot = slots_.at(cell / kFaceCount);
-    const size_t level = cell / level_cells();
-    return slot == kEmptySlot ? 0.0f : pools_[level][slot].opacity[cell % kFaceCount];
+    if (cell >= cell_count()) throw Error("cascaded voxel texture", "no cell " + std::to_string(cell));
+    const size_t level = cell / level_cells(), texel = (cell % level_cells()) / kFaceCount;
+    const PackedSurface* s = gbuffer_[level].find(texel, int(cell % kFaceCount) >> 1);
+    return s ? unpack_opacity(*s) : 0.0f;
 }
 
 FragmentVoxelizeStats CascadedVoxelTexture::voxelize_boxes(int level, const FragmentVoxelizer& voxelizer,
                                                            const std::vector<VoxelBox>& boxes,
                                                            const VoxelBox& exclude) {
     FragmentVoxelizeStats stats;
-    std::mutex pool_lock;  // the voxelizer emits from worker threads; the pool grows one at a time
+    std::mutex stage_lock;  // the voxelizer emits from worker threads; staging is one at a time
     const VoxelLattice on = lattice(level);
+    SparseGBuffer& g = gbuffer_[size_t(level)];
     voxelizer.voxelize_each(on, boxes, [&](const AnisotropicVoxel& v) {
         const PackedVoxel packed = pack_voxel(v, on);  // outside the lock
-        const std::lock_guard<std::mutex> hold(pool_lock);
-        store(level, packed);
+        const size_t texel = texel_index(v.coord);
+        const std::lock_guard<std::mutex> hold(stage_lock);
+        g.stage(texel, packed);
     }, &stats, exclude);
-    compact_if_sparse(level);
+    g.commit();
     return stats;
 }
 
@@ -320,19 +287,12 @@ FragmentVoxelizeStats CascadedVoxelTexture::follow_inner(int level, const Fragme
             pending.push_back(part);
         }
     }
-    if (pending.empty()) {
-        compact_if_sparse(level);
-        return stats;
-    }
+    if (pending.empty()) return stats;
     return voxelize_boxes(level, voxelizer, pending, inner);
 }
 
 bool CascadedVoxelTexture::occupied(int level, const IVec3& v) const {
-    const PackedVoxel* voxel = gbuffer_voxel(level, v);
-    if (!voxel) return false;
-    for (float a : voxel->opacity)
-        if (a > 0.0f) return true;
-    return false;
+    return contains(level, v) && gbuffer_[size_t(level)].occupied(texel_index(v));
 }
 
 size_t CascadedVoxelTexture::occupied_voxels(int level) const { return occupied_in(level, region(level)).size(); }
@@ -374,23 +334,23 @@ void CascadedVoxelTexture::downsample(int level, std::vector<HalfRGBA>& buffer) 
 
 void CascadedVoxelTexture::refresh_occupancy(int level, const std::vector<HalfRGBA>& buffer) {
     build_occupancy_map(buffer.data() + size_t(level) * level_cells(), config_.resolution, true,
-                        occupancy_.data() + size_t(level) * texels_per_level());
+                        occupancy_.data() + size_t(level) * occupancy_words());
 }
 
 size_t CascadedVoxelTexture::gbuffer_bytes() const {
-    size_t bytes = slots_.capacity() * sizeof(uint32_t);
-    for (const auto& pool : pools_) bytes += pool.capacity() * sizeof(PackedVoxel);
+    size_t bytes = 0;
+    for (const SparseGBuffer& g : gbuffer_) bytes += g.bytes();
     return bytes;
 }
 
 size_t CascadedVoxelTexture::occupancy_encoding_bytes() const {
-    size_t bytes = slots_.capacity() * sizeof(uint32_t);
-    for (const auto& pool : pools_) bytes += pool.capacity() * sizeof(float) * kFaceCount;
+    size_t bytes = 0;
+    for (const SparseGBuffer& g : gbuffer_) bytes += g.occupancy_bytes();
     return bytes;
 }
 
 size_t CascadedVoxelTexture::radiance_bytes() const {
-    return radiance.size() * sizeof(HalfRGBA) + occupancy_.size();
+    return radiance.size() * sizeof(HalfRGBA) + occupancy_.size() * sizeof(uint64_t);
 }
 
 }  // namespace gilab

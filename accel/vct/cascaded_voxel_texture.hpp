@@ -22,6 +22,7 @@
 #include "accel/vct/fragment_voxelizer.hpp"
 #include "accel/vct/half_rgba.hpp"
 #include "accel/vct/packed_surface.hpp"
+#include "accel/vct/sparse_gbuffer.hpp"
 #include "core/util/math.hpp"
 
 namespace gilab {
@@ -90,17 +91,16 @@ public:
     }
     size_t cell_count() const { return size_t(config_.levels) * level_cells(); }
 
-    // ---- G-buffer: sparse, as only surface voxels carry one. Per level a slot per texel
-    // (kEmptySlot, or the index of the voxel in the level's pool of PackedVoxel: the six
-    // faces' opacity and packed surface, accel/vct/packed_surface.hpp). Clearing frees
-    // slots; a pool holding more freed entries than live ones is compacted.
-    static constexpr uint32_t kEmptySlot = 0xFFFFFFFFu;
+    // ---- G-buffer: sparse, as only surface voxels carry one: per level a SparseGBuffer
+    // (accel/vct/sparse_gbuffer.hpp) of one 12-byte record per occupied axis of a voxel
+    // (accel/vct/packed_surface.hpp).
     void clear_gbuffer(int level, const VoxelBox& box);         // box ∩ region
     void clear_radiance(int level, const VoxelBox& box);
-    // Not thread-safe (the voxelize calls serialise their voxelizer's writes).
     void write(int level, const AnisotropicVoxel& voxel);       // must lie in the region
-    // The G-buffer voxel at world voxel v of the level, or nullptr (empty or outside).
-    const PackedVoxel* gbuffer_voxel(int level, const IVec3& v) const;
+    // The G-buffer record of an axis of world voxel v of the level, or nullptr (empty or outside).
+    const PackedSurface* gbuffer_axis(int level, const IVec3& v, int axis) const;
+    // All three axes (empty where nothing is stored).
+    PackedVoxel gbuffer_voxel(int level, const IVec3& v) const;
     // The opacity of cell `cell` (index()), 0 when its voxel is empty.
     float opacity_of_cell(size_t cell) const;
     // Voxelizes box ∩ region of the level into the G-buffer (clearing it first).
@@ -131,16 +131,17 @@ public:
 
     // ---- occupancy for cone marching: per level and texel t, whether any face of the
     // 2×2×2 texels from t up (toroidally) has opacity in `buffer` — the texels one
-    // trilinear sample reads. A sample whose byte is 0 reads nothing and is skipped.
-    // Starts all 1 (nothing skipped) and is exact after a refresh.
+    // trilinear sample reads, one bit per texel (occupancy_map.hpp). A sample whose bit is
+    // 0 reads nothing and is skipped. Starts all 1 (nothing skipped) and is exact after a
+    // refresh.
     void refresh_occupancy(int level, const std::vector<HalfRGBA>& buffer);
-    const uint8_t* occupancy(int level) const { return occupancy_.data() + size_t(level) * texels_per_level(); }
+    const uint64_t* occupancy(int level) const { return occupancy_.data() + size_t(level) * occupancy_words(); }
 
     // ---- memory
     size_t voxel_count() const { return size_t(config_.levels) * texels_per_level(); }
-    size_t gbuffer_bytes() const;   // slots and pools (their capacity)
+    size_t gbuffer_bytes() const;   // the sparse G-buffers (their capacity)
     size_t radiance_bytes() const;  // the radiance buffer and the occupancy map
-    // What encodes occupancy alone: the slots and the pools' float opacities.
+    // What encodes occupancy alone: the G-buffers' bits, rank counts and opacity bytes.
     size_t occupancy_encoding_bytes() const;
     size_t bytes() const { return gbuffer_bytes() + radiance_bytes(); }
     // What the paper's Tables 5/6 count: opacity only, one byte per voxel per face.
@@ -156,24 +157,20 @@ public:
 private:
     template <class Fn>
     void for_each_run(int level, const VoxelBox& box, Fn&& fn) const;
-    size_t slot_index(int level, const IVec3& v) const {
+    size_t texel_index(const IVec3& v) const {  // within a level
         const UVec3 t = texel_of(v);
         const size_t R = size_t(config_.resolution);
-        return ((size_t(level) * R + t.z) * R + t.y) * R + t.x;
+        return (size_t(t.z) * R + t.y) * R + t.x;
     }
-    // Voxelizes `boxes` minus `exclude` into the level with the writes serialised.
+    size_t occupancy_words() const { return (texels_per_level() + 63) / 64; }
+    // Voxelizes `boxes` minus `exclude` into the level.
     FragmentVoxelizeStats voxelize_boxes(int level, const FragmentVoxelizer& voxelizer,
                                          const std::vector<VoxelBox>& boxes, const VoxelBox& exclude);
-    void compact_if_sparse(int level);  // and trims unused pool capacity
-    void store(int level, const PackedVoxel& voxel);  // voxel.coord inside the region
     CascadeConfig config_;
     std::vector<IVec3> origins_;
     std::vector<VoxelBox> own_inner_;  // inner box excluded by the last voxelize_own / follow_inner
-    std::vector<char> gbuffer_clear_;  // per level: nothing written since the last full clear
-    std::vector<uint8_t> occupancy_;   // see refresh_occupancy
-    std::vector<uint32_t> slots_;                  // per level and texel, see the G-buffer
-    std::vector<std::vector<PackedVoxel>> pools_;  // per level
-    std::vector<size_t> freed_;                    // per level: pool entries no slot names
+    std::vector<uint64_t> occupancy_;  // see refresh_occupancy
+    std::vector<SparseGBuffer> gbuffer_;  // per level
 };
 
 // a − b as disjoint boxes (at most six).

@@ -43,7 +43,7 @@ DenseMipTexture::DenseMipTexture(const DenseMipConfig& config) : config_(config)
     occupancy_.resize(size_t(levels));
     for (int k = 0; k < levels; ++k) {
         radiance[size_t(k)].assign(cells(k), HalfRGBA{});
-        occupancy_[size_t(k)].assign(cells(k) / kFaceCount, 1);
+        occupancy_[size_t(k)].assign(occupancy_map_words(resolution(k)), ~uint64_t(0));
     }
 }
 
@@ -53,7 +53,7 @@ FragmentVoxelizeStats DenseMipTexture::voxelize(const FragmentVoxelizer& voxeliz
     voxels.clear();
     voxels.shrink_to_fit();
     voxels.reserve(full.size());
-    for (const AnisotropicVoxel& v : full) voxels.push_back(pack_voxel(v, lattice()));
+    for (const AnisotropicVoxel& v : full) voxels.push_back({v.coord, pack_voxel(v, lattice())});
     return stats;
 }
 
@@ -96,7 +96,7 @@ void DenseMipTexture::refresh_occupancy(const std::vector<std::vector<HalfRGBA>>
 size_t DenseMipTexture::radiance_bytes() const {
     size_t bytes = 0;
     for (const auto& l : radiance) bytes += l.size() * sizeof(HalfRGBA);
-    for (const auto& l : occupancy_) bytes += l.size();
+    for (const auto& l : occupancy_) bytes += l.size() * sizeof(uint64_t);
     return bytes;
 }
 

@@ -7,9 +7,10 @@
 // buffer is one allocation of RGBA16F texels laid out [z][y][x][face], as the cascades'
 // levels (accel/vct/cascaded_voxel_texture.hpp), and has the same occupancy map.
 //
-// The G-buffer stays sparse (the occupied voxels as a list, each face packed as the
-// cascades pack theirs, accel/vct/packed_surface.hpp): a dense G-buffer of six faces per
-// cell would not fit at the sizes the baseline runs at.
+// The G-buffer stays sparse (the occupied voxels as a list with their coordinates, each
+// voxel's three axis records packed as the cascades pack theirs,
+// accel/vct/packed_surface.hpp): a dense G-buffer per cell would not fit at the sizes
+// the baseline runs at.
 #include <cstdint>
 #include <vector>
 #include "accel/vct/anisotropic_voxel.hpp"
@@ -58,21 +59,21 @@ public:
     // in `buffer` (what one trilinear sample reads; 0: the sample is skipped). All 1
     // until the first refresh.
     void refresh_occupancy(const std::vector<std::vector<HalfRGBA>>& buffer);
-    const uint8_t* occupancy(int level) const { return occupancy_[size_t(level)].data(); }
+    const uint64_t* occupancy(int level) const { return occupancy_[size_t(level)].data(); }
 
     size_t voxel_count() const { return size_t(config_.resolution) * config_.resolution * config_.resolution; }
     size_t radiance_bytes() const;  // the radiance buffer and the occupancy maps
-    size_t gbuffer_bytes() const { return voxels.capacity() * sizeof(PackedVoxel); }
+    size_t gbuffer_bytes() const { return voxels.capacity() * sizeof(PackedVoxelAt); }
     size_t bytes() const { return radiance_bytes() + gbuffer_bytes(); }
 
-    std::vector<PackedVoxel> voxels;            // sparse G-buffer, (z, y, x) order
+    std::vector<PackedVoxelAt> voxels;          // sparse G-buffer, (z, y, x) order
     // Per level, premultiplied RGBA16F: the injection writes direct light, gathers the
     // voxel bounce from it, then overwrites it with direct + bounce (as the cascades).
     std::vector<std::vector<HalfRGBA>> radiance;
 
 private:
     DenseMipConfig config_;
-    std::vector<std::vector<uint8_t>> occupancy_;   // per level, see refresh_occupancy
+    std::vector<std::vector<uint64_t>> occupancy_;  // per level, a bit per texel, see refresh_occupancy
 };
 
 }  // namespace gilab

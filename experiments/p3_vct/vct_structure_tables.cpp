@@ -60,7 +60,7 @@ const std::map<std::string, std::string>& encodings() {
         {"MSVO", "OctoMap OcTree nodes (float log-odds + child-pointer array), memoryUsage()"},
         {"SVDAG", "32-bit words: per unique node a child-mask word + one 32-bit pointer per child (all leaves merged into one)"},
         {"OpenVDB", "OpenVDB tree (root, internal and 8³ leaf nodes), memUsage()"},
-        {"cascaded", "32-bit slot per cell + 32-bit float opacity per face of each occupied voxel"}};
+        {"cascaded", "3 bits per cell (one per axis) + a 32-bit rank count per 256 bits + 1 B opacity per occupied axis of a voxel"}};
     return e;
 }
 

@@ -12,6 +12,7 @@
 #else
 #define GILAB_CONE_AVX2 0
 #endif
+#include "accel/vct/occupancy_map.hpp"
 #include "core/util/error.hpp"
 
 namespace gilab {
@@ -218,7 +219,7 @@ template <bool kClip>
 [[gnu::always_inline]] inline Vec4 sample_portable(const ConeLevel& l, const Vec3& anchor, const Vec3& p,
                                                    const FaceWeights& faces, const Vec4* plane) {
     const SampleCorners c = corners_of(l, (p - anchor) * l.inv_voxel_size);
-    if (l.occupancy && !l.occupancy[c.occupancy]) return Vec4(0.0f);  // all eight texels empty
+    if (l.occupancy && !occupancy_bit(l.occupancy, c.occupancy)) return Vec4(0.0f);  // all eight texels empty
     if (!plane) return accumulate_portable<false>(l, c, faces, nullptr);
     float keep[3][8];
     clip_mask(l, anchor, c, faces, *plane, keep);
@@ -253,7 +254,7 @@ __attribute__((target("avx2,fma,f16c"), always_inline)) inline __m256 texel_sum(
 __attribute__((target("avx2,fma,f16c"))) Vec4 sample_avx2(const ConeLevel& l, const Vec3& anchor, const Vec3& p,
                                                           const FaceWeights& faces, const Vec4* plane) {
     const SampleCorners c = corners_of(l, (p - anchor) * l.inv_voxel_size);
-    if (l.occupancy && !l.occupancy[c.occupancy]) return Vec4(0.0f);  // all eight texels empty
+    if (l.occupancy && !occupancy_bit(l.occupancy, c.occupancy)) return Vec4(0.0f);  // all eight texels empty
     const __m256 w = texel_product(c.weight);
     alignas(32) float wf[3][8];
     if (!plane) {

@@ -46,7 +46,7 @@ const char* to_string(ConeKernel kernel);
 // One level of a voxel structure as the cone tracer reads it.
 struct ConeLevel {
     const HalfRGBA* data = nullptr; // cell of face 0, texel (0, 0, 0)
-    const uint8_t* occupancy = nullptr;  // per texel, see CascadedVoxelTexture::refresh_occupancy
+    const uint64_t* occupancy = nullptr;  // a bit per texel, see CascadedVoxelTexture::refresh_occupancy
     size_t face_stride = 1, x_stride = kFaceCount, row_stride = 0, slice_stride = 0;  // in cells
     size_t occupancy_row = 0, occupancy_slice = 0;  // in texels (x stride 1)
     IVec3 origin{0};                // region [origin, origin + size)

@@ -196,24 +196,29 @@ struct Shading {
     }
 };
 
-FaceInput face_input(float opacity, const PackedSurface& s, const Vec3& center, float voxel_size) {
-    if (!(opacity > 0)) return {};
-    return {opacity, unpack_albedo(s), unpack_normal(s), unpack_position(s, center, voxel_size)};
+// Faces +k and −k share axis k's record; −k's normal is its negation.
+VoxelInput input_of(const PackedVoxel& voxel, const VoxelLattice& lattice, const IVec3& coord) {
+    VoxelInput in;
+    const Vec3 center = voxel_center(lattice, coord);
+    const float size = float(lattice.voxel_size);
+    for (int k = 0; k < 3; ++k) {
+        const PackedSurface& s = voxel.axis[size_t(k)];
+        if (!s.opacity) continue;
+        FaceInput plus{unpack_opacity(s), unpack_albedo(s), unpack_normal(s), unpack_position(s, center, size)};
+        FaceInput minus = plus;
+        minus.normal = -plus.normal;
+        in[size_t(2 * k)] = plus;
+        in[size_t(2 * k + 1)] = minus;
+    }
+    return in;
 }
-
-VoxelInput input_of(const PackedVoxel& voxel, const VoxelLattice& lattice);
 
 VoxelInput input_of(const CascadedVoxelTexture& t, int level, const IVec3& v) {
-    const PackedVoxel* voxel = t.gbuffer_voxel(level, v);
-    return voxel ? input_of(*voxel, t.lattice(level)) : VoxelInput{};
+    return input_of(t.gbuffer_voxel(level, v), t.lattice(level), v);
 }
 
-VoxelInput input_of(const PackedVoxel& voxel, const VoxelLattice& lattice) {
-    VoxelInput in;
-    const Vec3 center = voxel_center(lattice, voxel.coord);
-    for (int f = 0; f < kFaceCount; ++f)
-        in[size_t(f)] = face_input(voxel.opacity[size_t(f)], voxel.surface[size_t(f)], center, float(lattice.voxel_size));
-    return in;
+VoxelInput input_of(const PackedVoxelAt& voxel, const VoxelLattice& lattice) {
+    return input_of(voxel.voxel, lattice, voxel.coord);
 }
 
 // Meshes under an animated node (or an animated ancestor) are dynamic.

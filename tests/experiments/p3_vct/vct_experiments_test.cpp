@@ -111,10 +111,11 @@ TEST_F(VctExperiments, MemoryChargesEachStructureItsRealEncodingInMegabytesOfTen
             ++checked;
         } else if (structure == "cascaded") {
             const double levels = std::log2(n / 32.0) + 1;  // 32³ per level, finest voxel = the grid's
-            // A 32-bit G-buffer slot per cell, and a float per face of the occupied voxels
-            // only: more than the slots, less than a slot and six floats per cell.
-            EXPECT_GT(memory, levels * 32 * 32 * 32 * 4 / 1e6) << row.dump();
-            EXPECT_LT(memory, levels * 32 * 32 * 32 * (4 + 6 * 4) / 1e6) << row.dump();
+            // Three bits per cell and a 32-bit rank count per 256 bits, and an opacity byte
+            // per occupied axis only: more than the bits, less than the bits, counts and
+            // three bytes per cell.
+            EXPECT_GT(memory, levels * 32 * 32 * 32 * 3.0 / 8.0 / 1e6) << row.dump();
+            EXPECT_LT(memory, levels * 32 * 32 * 32 * (3.0 * (1.0 + 32.0 / 256.0) / 8.0 + 3.0) / 1e6) << row.dump();
             ++checked;
         } else if (structure == "SVO") {
             // A mask byte per node, a 4-byte index per node with children: more than 1 B
