@@ -96,6 +96,7 @@ public:
     // (accel/vct/packed_surface.hpp).
     void clear_gbuffer(int level, const VoxelBox& box);         // box ∩ region
     void clear_radiance(int level, const VoxelBox& box);
+    // One voxel, committed at once (the voxelize calls stage a whole pass, then commit).
     void write(int level, const AnisotropicVoxel& voxel);       // must lie in the region
     // The G-buffer record of an axis of world voxel v of the level, or nullptr (empty or outside).
     const PackedSurface* gbuffer_axis(int level, const IVec3& v, int axis) const;

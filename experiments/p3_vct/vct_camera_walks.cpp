@@ -357,9 +357,9 @@ void register_camera_walks(ExperimentRegistry& registry) {
         .reducer = "vct-fig10",
         .notes = {walk_note(),
                   "Structure memory = every attribute array the technique holds (dense: the radiance mip chain as "
-                  "RGBA16F × 6 faces, its occupancy bytes and the sparse G-buffer list; cascaded: the radiance "
-                  "buffer of 6 × 32³ × 6 faces RGBA16F, its occupancy bytes and the sparse G-buffer — a slot per "
-                  "texel and the occupied voxels; photon mapping: the hash-grid photon map; LPV: per cascade its four SH volumes, geometry "
+                  "RGBA16F × 6 faces, its occupancy bits and the sparse G-buffer list; cascaded: the radiance "
+                  "buffer of 6 × 32³ × 6 faces RGBA16F, its occupancy bits and the sparse G-buffer — a bit per "
+                  "texel and axis, rank counts and a 12-byte record per occupied axis of a voxel; photon mapping: the hash-grid photon map; LPV: per cascade its four SH volumes, geometry "
                   "volume and face transmittances, and the frame's VPLs and surfels). Process RSS is the whole process "
                   "after each frame of the last variant. The paper reports whole-application memory (cascaded ≈ 40 % "
                   "of VXGI; its PM figure is only drawn, not printed)."},
