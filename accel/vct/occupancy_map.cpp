@@ -21,20 +21,22 @@ void build_occupancy_map(const HalfRGBA* cells, int r, bool toroidal, uint64_t* 
     // The upper neighbour along an axis: wrapped, or the border texel itself (a sample
     // there reads it twice).
     auto up = [&](int i) { return toroidal ? (i + 1) & (r - 1) : std::min(i + 1, r - 1); };
-    std::vector<uint8_t> bytes(texels);
-    parallel_for(n, 1, [&](size_t z0, size_t z1) {
-        for (int z = int(z0); z < int(z1); ++z)
-            for (int y = 0; y < r; ++y)
-                for (int x = 0; x < r; ++x) {
-                    const int xs[2] = {x, up(x)}, ys[2] = {y, up(y)}, zs[2] = {z, up(z)};
-                    uint8_t o = 0;
-                    for (int c = 0; c < 8; ++c)
-                        o |= any[(size_t(zs[c >> 2]) * n + size_t(ys[(c >> 1) & 1])) * n + size_t(xs[c & 1])];
-                    bytes[(size_t(z) * n + size_t(y)) * n + size_t(x)] = o;
-                }
+    // One task per run of 64-bit words: each word's 64 texels are written by one thread.
+    const size_t words = occupancy_map_words(r);
+    parallel_for(words, 64, [&](size_t w0, size_t w1) {
+        for (size_t w = w0; w < w1; ++w) {
+            uint64_t word = 0;
+            for (size_t t = w * 64; t < std::min(texels, (w + 1) * 64); ++t) {
+                const int x = int(t % n), y = int(t / n % n), z = int(t / (n * n));
+                const int xs[2] = {x, up(x)}, ys[2] = {y, up(y)}, zs[2] = {z, up(z)};
+                uint64_t o = 0;
+                for (int c = 0; c < 8; ++c)
+                    o |= any[(size_t(zs[c >> 2]) * n + size_t(ys[(c >> 1) & 1])) * n + size_t(xs[c & 1])];
+                word |= o << (t & 63);
+            }
+            out[w] = word;
+        }
     });
-    std::fill_n(out, occupancy_map_words(r), uint64_t(0));
-    for (size_t t = 0; t < texels; ++t) out[t >> 6] |= uint64_t(bytes[t]) << (t & 63);
 }
 
 }  // namespace gilab
