@@ -39,7 +39,7 @@ struct CornellPhotons {
                 Hit hit = tracer.intersect(ray);
                 if (!hit.valid()) continue;
                 SurfaceInteraction si = make_interaction(frame, ray, hit);
-                points.push_back({si.position, si.shading_normal, si.wo, si.material});
+                points.push_back({si.position, si.shading_normal, si.wo, si.material, scene.materials[si.material]});
             }
     }
 };
@@ -97,7 +97,7 @@ void BM_Gather(benchmark::State& state) {
     const float r = kRadii[state.range(0)];
     const PhotonMap& map = structure(Kind, r);
     const auto& f = fixture();
-    PhotonGatherer gatherer(map, f.scene.materials, GatherMode::Radius, 128);
+    PhotonGatherer gatherer(map, GatherMode::Radius, 128);
     GatherScratch scratch;
     PhotonQueryStats stats;
     for (auto _ : state) {

@@ -94,8 +94,64 @@ FragmentVoxelizer::FragmentVoxelizer(const SceneFrame& frame, const std::vector<
             tri.hi = glm::max(tri.p[0], glm::max(tri.p[1], tri.p[2]));
             tri.albedo = materials[id].albedo;
             tri.emission = materials[id].emission;
+            if (materials[id].has_textures()) {
+                TexturedCorners tc;
+                tc.material = id;
+                for (int k = 0; k < kUvSetCount; ++k) {
+                    const std::vector<Vec2>& set = mesh.uv_set(k);
+                    if (set.size() != mesh.positions.size()) continue;
+                    for (int c = 0; c < 3; ++c) tc.uv[k][c] = set[idx[c]];
+                    const Vec2 d1 = tc.uv[k][1] - tc.uv[k][0], d2 = tc.uv[k][2] - tc.uv[k][0];
+                    tc.uv_per_length[k] = float(std::sqrt(std::abs(double(d1.x) * d2.y - double(d1.y) * d2.x) / len));
+                }
+                tri.textured = int32_t(textured_.size());
+                textured_.push_back(tc);
+            }
             for (int k = 0; k < 3; ++k) bounds_.extend(Vec3(tri.p[k]));
             triangles_.push_back(tri);
+        }
+    }
+    if (!textured_.empty()) materials_ = materials;
+}
+
+void FragmentVoxelizer::texture_fragment(const Triangle& t, const DVec3& centroid, double area, Vec3& albedo,
+                                         Vec3& emission, double& coverage) const {
+    const TexturedCorners& tc = textured_[size_t(t.textured)];
+    const Material& m = materials_[tc.material];
+    // Barycentrics of the centroid (it lies in the triangle's plane).
+    const DVec3 e1 = t.p[1] - t.p[0], e2 = t.p[2] - t.p[0], d = centroid - t.p[0];
+    const double d11 = glm::dot(e1, e1), d12 = glm::dot(e1, e2), d22 = glm::dot(e2, e2);
+    const double den = d11 * d22 - d12 * d12;
+    double b1 = 0, b2 = 0;
+    if (den > 0) {
+        b1 = (d22 * glm::dot(d, e1) - d12 * glm::dot(d, e2)) / den;
+        b2 = (d11 * glm::dot(d, e2) - d12 * glm::dot(d, e1)) / den;
+    }
+    const float w1 = float(b1), w2 = float(b2), w0 = 1.0f - w1 - w2;
+    const float size = float(std::sqrt(area));
+    auto at = [&](const TextureRef& ref, float& footprint) {
+        const int k = std::clamp(ref.uv_set, 0, kUvSetCount - 1);
+        footprint = size * tc.uv_per_length[k];
+        return w0 * tc.uv[k][0] + w1 * tc.uv[k][1] + w2 * tc.uv[k][2];
+    };
+    float footprint = 0;
+    if (m.albedo_texture) {
+        const Vec2 uv = at(m.albedo_texture, footprint);
+        albedo = t.albedo * Vec3(m.albedo_texture.sample(uv, footprint));
+    }
+    if (m.emission_texture && m.is_emissive()) {
+        const Vec2 uv = at(m.emission_texture, footprint);
+        emission = t.emission * Vec3(m.emission_texture.sample(uv, footprint));
+    }
+    if (m.alpha_tested()) {
+        if (!m.alpha_texture) {
+            coverage = m.alpha >= m.alpha_cutoff ? 1.0 : 0.0;
+        } else {
+            const Vec2 uv = at(m.alpha_texture, footprint);
+            const MipMap& img = *m.alpha_texture.image;
+            const float lod = footprint > 0 ? img.level_for_footprint(footprint * m.alpha_texture.transform.max_stretch()) : 0;
+            const float a = m.alpha * m.alpha_texture.sample(uv, footprint).w;
+            coverage = lod <= 0.0f ? (a >= m.alpha_cutoff ? 1.0 : 0.0) : std::clamp(double(a), 0.0, 1.0);
         }
     }
 }
@@ -286,6 +342,13 @@ void FragmentVoxelizer::run(const VoxelLattice& lattice, std::span<const VoxelBo
                                 if (!(area > 0)) continue;
                                 centroid /= area;
                             }
+                            Vec3 albedo = t.albedo, emission = t.emission;
+                            if (t.textured >= 0) {
+                                double coverage = 1;
+                                texture_fragment(t, centroid, area, albedo, emission, coverage);
+                                area *= coverage;
+                                if (!(area > 0)) continue;  // only transparent texels reach this voxel
+                            }
                             ++fragments;
                             const IVec3 l = v - brick_lo;
                             int& s = slot[size_t((l.z * kBrick + l.y) * kBrick + l.x)];
@@ -300,9 +363,9 @@ void FragmentVoxelizer::run(const VoxelLattice& lattice, std::span<const VoxelBo
                                 if (!(weight > 0)) continue;
                                 AxisSums& as = vs.axis[k];
                                 as.weight += weight;
-                                as.albedo += weight * DVec3(t.albedo);
+                                as.albedo += weight * DVec3(albedo);
                                 as.normal += (nk > 0 ? weight : -weight) * t.normal;
-                                as.emission[nk > 0 ? 0 : 1] += weight * DVec3(t.emission);
+                                as.emission[nk > 0 ? 0 : 1] += weight * DVec3(emission);
                                 as.position += weight * centroid;
                             }
                         }

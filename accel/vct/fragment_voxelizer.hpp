@@ -8,6 +8,13 @@
 // oriented normal, emission and position are the weighted means. Emission counts only
 // on the side the triangle's winding normal faces (emitters are one-sided).
 //
+// Textured triangles: a fragment's albedo and emission are their textures filtered over
+// the fragment (looked up at its centroid, at the mip level of its size, so a voxel holds
+// the texture's average over its part of the triangle). An alpha-masked fragment weighs
+// A times its mask coverage: the mean alpha over the fragment at that level, or, for a
+// fragment smaller than a texel, 1 where alpha ≥ the cutoff and 0 elsewhere; a voxel
+// that only transparent texels reach therefore stays empty.
+//
 // Voxels live on an infinite lattice: world voxel v spans anchor + [v, v+1)·voxel_size,
 // so the same voxel gets identical values whatever region it is voxelized in (the
 // cascades rely on it when they scroll). A triangle lying exactly in a voxel's upper
@@ -91,8 +98,20 @@ private:
         DVec3 centroid;
         double area;
         Vec3 albedo, emission;
+        int32_t textured = -1;  // index into textured_, or −1
     };
+    // What a textured triangle's fragments read: its material and its corners' UVs.
+    struct TexturedCorners {
+        uint32_t material = 0;
+        Vec2 uv[kUvSetCount][3]{};
+        float uv_per_length[kUvSetCount]{};
+    };
+    // A fragment's material values and weight factor (mask coverage) at `centroid`.
+    void texture_fragment(const Triangle& t, const DVec3& centroid, double area, Vec3& albedo, Vec3& emission,
+                          double& coverage) const;
     std::vector<Triangle> triangles_;
+    std::vector<TexturedCorners> textured_;
+    std::vector<Material> materials_;  // the scene's (textures shared, not copied)
     Bounds3 bounds_;
 };
 

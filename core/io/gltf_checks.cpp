@@ -308,27 +308,4 @@ void use_checked_file_access(tinygltf::TinyGLTF& reader) {
     reader.SetFsCallbacks(callbacks);
 }
 
-std::optional<std::pair<uint32_t, uint32_t>> encoded_image_size(const unsigned char* b, size_t size) {
-    auto be16 = [&](size_t at) { return uint32_t(b[at]) << 8 | b[at + 1]; };
-    auto be32 = [&](size_t at) { return be16(at) << 16 | be16(at + 2); };
-    if (size >= 24 && std::memcmp(b, "\x89PNG\r\n\x1a\n", 8) == 0 && std::memcmp(b + 12, "IHDR", 4) == 0)
-        return std::pair{be32(16), be32(20)};
-    if (size >= 4 && b[0] == 0xFF && b[1] == 0xD8) {
-        size_t at = 2;
-        while (at + 9 < size) {
-            if (b[at] != 0xFF) return std::nullopt;
-            const unsigned char marker = b[at + 1];
-            if (marker == 0xFF) {
-                ++at;
-                continue;
-            }
-            // Start-of-frame markers carry the size; C4 (DHT), C8 and CC (DAC) do not.
-            if (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC)
-                return std::pair{be16(at + 7), be16(at + 5)};
-            at += 2 + be16(at + 2);
-        }
-    }
-    return std::nullopt;
-}
-
 }  // namespace gilab

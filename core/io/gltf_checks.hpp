@@ -28,7 +28,5 @@ GltfInput check_gltf_file(const std::filesystem::path& path, const std::string& 
 // the memory budget (a uri of "." would otherwise read a directory as a huge file).
 void use_checked_file_access(tinygltf::TinyGLTF& reader);
 
-// Width and height from a PNG or JPEG header, without decoding.
-std::optional<std::pair<uint32_t, uint32_t>> encoded_image_size(const unsigned char* bytes, size_t size);
 
 }  // namespace gilab

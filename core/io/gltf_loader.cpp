@@ -5,8 +5,15 @@
 // Units and conventions:
 //  * Light intensities are taken as they are: candela (lm/sr) for point/spot lights is
 //    used as W/sr, lux (lm/m²) for directional lights as W/m²; `color` multiplies it.
-//  * Base-colour and emissive textures are not sampled per texel; their mean linear
-//    colour multiplies the factor, so a textured material keeps its average tint.
+//  * Textures: baseColorTexture (sRGB; its alpha is the mask's), emissiveTexture (sRGB),
+//    normalTexture (linear, with its scale), each with its texCoord set (0 or 1), its
+//    sampler's wrap modes and KHR_texture_transform. Images are decoded once (through
+//    core/texture/image_decode.hpp, within the memory budget) and shared between
+//    materials. An image that cannot be decoded or is refused leaves its materials with
+//    their factors alone and a warning naming it. alphaMode MASK tests alphaCutoff;
+//    BLEND is read as MASK at 0.5 with a warning. The base colour texture multiplies the
+//    diffuse albedo; a metal's glossy lobe keeps its factor's colour. metallicRoughness and occlusion
+//    textures are not read (the Phong lobe has one roughness per material).
 //  * CUBICSPLINE animation samplers use each key's value and ignore the tangents (the
 //    curve is then interpolated linearly between keys).
 //  * When several animations drive the same property of a node, the first one wins.
@@ -38,6 +45,7 @@
 #include "core/util/memory_budget.hpp"
 #include "core/io/mesh_loaders.hpp"
 #include "core/scene/skin.hpp"
+#include "core/texture/image_decode.hpp"
 
 namespace gilab {
 
@@ -50,6 +58,8 @@ struct Context {
     std::string file;
     Scene& scene;
     uint64_t input_bytes = 0;  // the file and its buffers
+    // Each image decoded once per encoding, shared by every material that uses it.
+    std::map<std::pair<int, ColorEncoding>, std::shared_ptr<const MipMap>> images;
     void warn(const std::string& message) {
         const std::string w = file + ": " + message;
         for (const auto& existing : scene.warnings)
@@ -320,42 +330,93 @@ SceneCamera camera_at_node(const std::string& file, const tinygltf::Camera& c, i
     return cam;
 }
 
-float srgb_to_linear(float c) {
-    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+WrapMode wrap_mode(int gl) {
+    switch (gl) {
+        case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return WrapMode::ClampToEdge;
+        case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return WrapMode::MirroredRepeat;
+        default: return WrapMode::Repeat;  // REPEAT, and glTF's default when absent
+    }
 }
 
-// Mean linear colour of a decoded texture (sRGB-encoded colour textures); nullopt when
-// the image could not be decoded.
-std::optional<Vec3> mean_texture_color(const tinygltf::Model& m, int texture_index) {
-    if (texture_index < 0 || size_t(texture_index) >= m.textures.size()) return std::nullopt;
-    const int source = m.textures[size_t(texture_index)].source;
-    if (source < 0 || size_t(source) >= m.images.size()) return std::nullopt;
-    const tinygltf::Image& img = m.images[size_t(source)];
-    if (img.image.empty() || img.width <= 0 || img.height <= 0 || img.component <= 0) return std::nullopt;
-    const size_t bytes = img.bits == 16 ? 2 : 1;
-    const size_t pixels = size_t(img.width) * size_t(img.height);
-    if (img.image.size() < pixels * size_t(img.component) * bytes) return std::nullopt;
-    const size_t step = std::max<size_t>(1, pixels / 65536);
-    glm::dvec3 sum(0);
-    size_t n = 0;
-    for (size_t p = 0; p < pixels; p += step, ++n) {
-        Vec3 c;
-        for (int k = 0; k < 3; ++k) {
-            const int ch = img.component >= 3 ? k : 0;
-            const size_t at = (p * size_t(img.component) + size_t(ch)) * bytes;
-            float v;
-            if (bytes == 2) {
-                uint16_t s;
-                std::memcpy(&s, &img.image[at], 2);
-                v = float(s) / 65535.0f;
-            } else {
-                v = float(img.image[at]) / 255.0f;
-            }
-            c[k] = srgb_to_linear(v);
-        }
-        sum += glm::dvec3(c);
+// A finite number from an extension object, or `fallback` when absent.
+double extension_number(const std::string& file, const tinygltf::Value& obj, const char* key, double fallback,
+                        const std::string& ptr) {
+    if (!obj.Has(key)) return fallback;
+    const tinygltf::Value& v = obj.Get(key);
+    const double x = v.IsNumber() ? v.GetNumberAsDouble() : std::nan("");
+    if (!(std::isfinite(x) && std::abs(x) <= 1e30)) throw Error(file, ptr + "/" + key + ": not a finite number");
+    return x;
+}
+
+Vec2 extension_pair(const std::string& file, const tinygltf::Value& obj, const char* key, Vec2 fallback,
+                    const std::string& ptr) {
+    if (!obj.Has(key)) return fallback;
+    const tinygltf::Value& v = obj.Get(key);
+    if (!v.IsArray() || v.ArrayLen() != 2) throw Error(file, ptr + "/" + key + ": not an array of two numbers");
+    Vec2 out;
+    for (int k = 0; k < 2; ++k) {
+        const tinygltf::Value& e = v.Get(k);
+        const double x = e.IsNumber() ? e.GetNumberAsDouble() : std::nan("");
+        if (!(std::isfinite(x) && std::abs(x) <= 1e30))
+            throw Error(file, ptr + "/" + key + "/" + std::to_string(k) + ": not a finite number");
+        out[k] = float(x);
     }
-    return Vec3(sum / double(n));
+    return out;
+}
+
+// The decoded image of texture `texture_index`, or null (with a warning) when it has no
+// usable image.
+std::shared_ptr<const MipMap> texture_image(Context& ctx, int texture_index, ColorEncoding encoding,
+                                            const std::string& what) {
+    if (texture_index < 0 || size_t(texture_index) >= ctx.model.textures.size())
+        throw Error(ctx.file, what + ": texture " + std::to_string(texture_index) + " does not exist (the file has " +
+                                  std::to_string(ctx.model.textures.size()) + ")");
+    const int source = ctx.model.textures[size_t(texture_index)].source;
+    if (source < 0 || size_t(source) >= ctx.model.images.size()) {
+        ctx.warn(what + ": texture " + std::to_string(texture_index) + " has no image; the factor alone is used");
+        return nullptr;
+    }
+    const auto key = std::make_pair(source, encoding);
+    if (auto it = ctx.images.find(key); it != ctx.images.end()) return it->second;
+    const tinygltf::Image& img = ctx.model.images[size_t(source)];
+    std::shared_ptr<const MipMap> out;
+    if (img.image.empty() || img.component != 4 || img.bits != 8 ||
+        img.image.size() != size_t(img.width) * size_t(img.height) * 4) {
+        ctx.warn(what + ": image " + std::to_string(source) + " was not decoded; the factor alone is used");
+    } else {
+        Rgba8Image base{img.width, img.height, img.image};
+        const std::string name = img.name.empty() ? (img.uri.empty() ? "image " + std::to_string(source) : img.uri) : img.name;
+        out = std::make_shared<const MipMap>(std::move(base), encoding, ctx.file + ": " + name);
+    }
+    ctx.images[key] = out;
+    return out;
+}
+
+// A material's texture slot: image, UV set, sampler wrap modes and KHR_texture_transform.
+TextureRef texture_ref(Context& ctx, int index, int tex_coord, const tinygltf::ExtensionMap& extensions,
+                       ColorEncoding encoding, const std::string& ptr, const std::string& what) {
+    TextureRef ref;
+    ref.image = texture_image(ctx, index, encoding, what);
+    if (!ref.image) return ref;
+    ref.uv_set = tex_coord;
+    const tinygltf::Texture& tex = ctx.model.textures[size_t(index)];
+    if (tex.sampler >= 0 && size_t(tex.sampler) < ctx.model.samplers.size()) {
+        const tinygltf::Sampler& sm = ctx.model.samplers[size_t(tex.sampler)];
+        ref.wrap_s = wrap_mode(sm.wrapS);
+        ref.wrap_t = wrap_mode(sm.wrapT);
+    }
+    if (auto ext = extensions.find("KHR_texture_transform"); ext != extensions.end()) {
+        const std::string xp = ptr + "/extensions/KHR_texture_transform";
+        ref.transform.offset = extension_pair(ctx.file, ext->second, "offset", Vec2(0.0f), xp);
+        ref.transform.rotation = float(extension_number(ctx.file, ext->second, "rotation", 0.0, xp));
+        ref.transform.scale = extension_pair(ctx.file, ext->second, "scale", Vec2(1.0f), xp);
+        ref.uv_set = int(extension_number(ctx.file, ext->second, "texCoord", double(ref.uv_set), xp));
+    }
+    if (ref.uv_set < 0 || ref.uv_set >= kUvSetCount) {
+        ctx.warn(what + ": texCoord " + std::to_string(ref.uv_set) + " is not supported (TEXCOORD_0 and _1 are); the factor alone is used");
+        return TextureRef{};
+    }
+    return ref;
 }
 
 // KHR_materials_emissive_strength: a finite number ≥ 0 (1 when absent), checked like a
@@ -379,12 +440,12 @@ Material convert_material(Context& ctx, const tinygltf::Material& gm, size_t ind
     const auto& pbr = gm.pbrMetallicRoughness;
     Vec3 base(1.0f);
     if (pbr.baseColorFactor.size() >= 3) base = Vec3(pbr.baseColorFactor[0], pbr.baseColorFactor[1], pbr.baseColorFactor[2]);
-    if (pbr.baseColorTexture.index >= 0) {
-        if (auto mean = mean_texture_color(ctx.model, pbr.baseColorTexture.index))
-            base *= *mean;
-        else
-            ctx.warn("material '" + out.name + "': base colour texture could not be decoded; using the factor alone");
-    }
+    const std::string ptr = "/materials/" + std::to_string(index);
+    const std::string what = "material '" + out.name + "'";
+    if (pbr.baseColorTexture.index >= 0)
+        out.albedo_texture = texture_ref(ctx, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+                                         pbr.baseColorTexture.extensions, ColorEncoding::Srgb,
+                                         ptr + "/pbrMetallicRoughness/baseColorTexture", what + " base colour");
     base = glm::clamp(base, Vec3(0.0f), Vec3(1.0f));
     const float metallic = std::clamp(float(pbr.metallicFactor), 0.0f, 1.0f);
     const float roughness = std::clamp(float(pbr.roughnessFactor), 0.0f, 1.0f);
@@ -401,10 +462,32 @@ Material convert_material(Context& ctx, const tinygltf::Material& gm, size_t ind
     Vec3 emission(0.0f);
     if (gm.emissiveFactor.size() >= 3) emission = Vec3(gm.emissiveFactor[0], gm.emissiveFactor[1], gm.emissiveFactor[2]);
     emission *= emissive_strength(ctx.file, gm, index, out.name);
-    if (gm.emissiveTexture.index >= 0 && max_component(emission) > 0.0f) {
-        if (auto mean = mean_texture_color(ctx.model, gm.emissiveTexture.index)) emission *= *mean;
-    }
+    if (gm.emissiveTexture.index >= 0 && max_component(emission) > 0.0f)
+        out.emission_texture = texture_ref(ctx, gm.emissiveTexture.index, gm.emissiveTexture.texCoord,
+                                           gm.emissiveTexture.extensions, ColorEncoding::Srgb, ptr + "/emissiveTexture",
+                                           what + " emission");
     out.emission = glm::max(emission, Vec3(0.0f));
+    if (gm.normalTexture.index >= 0) {
+        out.normal_texture = texture_ref(ctx, gm.normalTexture.index, gm.normalTexture.texCoord,
+                                         gm.normalTexture.extensions, ColorEncoding::Linear, ptr + "/normalTexture",
+                                         what + " normal map");
+        if (!std::isfinite(gm.normalTexture.scale)) throw Error(ctx.file, ptr + "/normalTexture/scale: not a finite number");
+        out.normal_scale = float(gm.normalTexture.scale);
+    }
+    // Alpha: the base colour's alpha factor times its texture's alpha channel.
+    out.alpha = pbr.baseColorFactor.size() >= 4 ? std::clamp(float(pbr.baseColorFactor[3]), 0.0f, 1.0f) : 1.0f;
+    if (gm.alphaMode == "MASK" || gm.alphaMode == "BLEND") {
+        out.alpha_mode = AlphaMode::Mask;
+        out.alpha_texture = out.albedo_texture;
+        out.alpha_cutoff = 0.5f;
+        if (gm.alphaMode == "MASK") {
+            if (!(std::isfinite(gm.alphaCutoff) && gm.alphaCutoff >= 0))
+                throw Error(ctx.file, ptr + "/alphaCutoff: " + number_as_given(gm.alphaCutoff) + " is not a cutoff (need a finite number ≥ 0)");
+            out.alpha_cutoff = float(gm.alphaCutoff);
+        } else {
+            ctx.warn(what + ": alphaMode BLEND is rendered as MASK at alpha 0.5 (no partial transparency)");
+        }
+    }
     return out;
 }
 
@@ -477,7 +560,7 @@ struct MeshBuilder {
         const tinygltf::Mesh& gm = ctx.model.meshes[mesh_index];
         Mesh mesh;
         mesh.name = gm.name.empty() ? "mesh" + std::to_string(mesh_index) : gm.name;
-        bool all_normals = true, all_uvs = true;
+        bool all_normals = true, all_uvs[kUvSetCount] = {true, true};
         for (size_t p = 0; p < gm.primitives.size(); ++p) {
             const tinygltf::Primitive& prim = gm.primitives[p];
             const std::string where = "mesh '" + mesh.name + "' primitive " + std::to_string(p);
@@ -505,14 +588,18 @@ struct MeshBuilder {
                 all_normals = false;
             }
             read_influences(prim, where, count, mesh);
-            auto uv_it = prim.attributes.find("TEXCOORD_0");
-            if (uv_it != prim.attributes.end() && all_uvs) {
-                const std::vector<float> uv = read_floats(ctx, uv_it->second, 2, where + " TEXCOORD_0");
-                if (uv.size() / 2 != count)
-                    throw Error(ctx.file, where + ": TEXCOORD_0 count differs from POSITION count");
-                for (size_t i = 0; i < count; ++i) mesh.uvs.emplace_back(uv[2 * i], uv[2 * i + 1]);
-            } else {
-                all_uvs = false;
+            for (int k = 0; k < kUvSetCount; ++k) {
+                const std::string attribute = "TEXCOORD_" + std::to_string(k);
+                std::vector<Vec2>& set = k == 0 ? mesh.uvs : mesh.uvs1;
+                auto uv_it = prim.attributes.find(attribute);
+                if (uv_it != prim.attributes.end() && all_uvs[k]) {
+                    const std::vector<float> uv = read_floats(ctx, uv_it->second, 2, where + " " + attribute);
+                    if (uv.size() / 2 != count)
+                        throw Error(ctx.file, where + ": " + attribute + " count differs from POSITION count");
+                    for (size_t i = 0; i < count; ++i) set.emplace_back(uv[2 * i], uv[2 * i + 1]);
+                } else {
+                    all_uvs[k] = false;
+                }
             }
 
             std::vector<uint32_t> idx;
@@ -546,7 +633,8 @@ struct MeshBuilder {
             }
         }
         if (!all_normals) mesh.normals.clear();
-        if (!all_uvs) mesh.uvs.clear();
+        if (!all_uvs[0]) mesh.uvs.clear();
+        if (!all_uvs[1]) mesh.uvs1.clear();
         for (const Vec3& n : mesh.normals)
             if (!(glm::dot(n, n) > 0.0f) || !is_finite(n)) {
                 ctx.warn("mesh '" + mesh.name + "': invalid vertex normals; using flat shading");
@@ -675,23 +763,24 @@ void load_animations(Context& ctx, const std::vector<int>& gltf_to_node) {
     if (ignored_weights) ctx.warn("morph-target weight animations are not supported and were ignored");
 }
 
-bool load_image_tolerant(tinygltf::Image* image, const int index, std::string* err, std::string* warn, int w, int h,
-                         const unsigned char* bytes, int size, void* user) {
-    // Decoding allocates what the image header says; a texture too large for the
-    // memory budget is skipped like an undecodable one.
-    if (auto dims = encoded_image_size(bytes, size_t(std::max(size, 0)))) {
-        const uint64_t decoded = MemoryBudget::times(uint64_t(dims->first) * dims->second, 8);
-        if (decoded > MemoryBudget::limit()) {
-            if (warn)
-                *warn += "image " + std::to_string(index) + " (" + std::to_string(dims->first) + "x" +
-                         std::to_string(dims->second) + ") would exceed the memory limit when decoded and is ignored\n";
-            return true;
-        }
+// tinygltf's image callback: images are decoded by gilab's texture decoder (its checks
+// and memory budget). A refused or undecodable image is a warning, not an error: its
+// materials keep their factors (texture_image says so again for each one).
+bool load_image_tolerant(tinygltf::Image* image, const int index, std::string* err, std::string* warn, int, int,
+                         const unsigned char* bytes, int size, void*) {
+    (void)err;
+    try {
+        Rgba8Image decoded = decode_image(std::span(bytes, size_t(std::max(size, 0))),
+                                          "image " + std::to_string(index) + (image->uri.empty() ? "" : " ('" + image->uri + "')"));
+        image->width = decoded.width;
+        image->height = decoded.height;
+        image->component = 4;
+        image->bits = 8;
+        image->pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+        image->image = std::move(decoded.texels);
+    } catch (const Error& e) {
+        if (warn) *warn += std::string(e.what()) + "; it is ignored\n";
     }
-    std::string decode_error;
-    if (tinygltf::LoadImageData(image, index, &decode_error, warn, w, h, bytes, size, user)) return true;
-    // Textures only tint materials here; an undecodable image is not fatal.
-    if (warn) *warn += "image " + std::to_string(index) + " could not be decoded and is ignored\n";
     return true;
 }
 

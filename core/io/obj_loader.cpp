@@ -2,8 +2,18 @@
 // 0 and skips faces with bad indices with only a warning, so the OBJ and MTL text is
 // checked first (core/io/obj_check.hpp) and problems are reported with their line number.
 // Polygons are triangulated in their best-fit plane (core/io/polygon_triangulation.hpp).
+//
+// MTL textures: map_Kd (sRGB, multiplies Kd), map_Ke (sRGB, multiplies Ke), map_d (an
+// alpha mask tested at 0.5; a file without an alpha channel gives its red channel),
+// norm and map_bump (read as tangent-space normal maps, -bm scaling x and y, as the
+// exporters of the shipped scenes write them). Options -s and -o transform the
+// coordinates, -clamp on clamps them. Texture files are looked up beside the OBJ; one
+// that is missing or cannot be decoded leaves the material with its colour and a
+// warning naming the file. OBJ's v axis points up the image; the texture transform
+// flips it to the image's top-row-first order.
 #include <tiny_obj_loader.h>
 
+#include <map>
 #include <regex>
 #include <unordered_map>
 #include "core/util/error.hpp"
@@ -11,6 +21,7 @@
 #include "core/io/mesh_loaders.hpp"
 #include "core/io/obj_check.hpp"
 #include "core/io/polygon_triangulation.hpp"
+#include "core/texture/image_decode.hpp"
 
 namespace gilab {
 
@@ -52,6 +63,67 @@ Material convert_material(const tinyobj::material_t& m, bool& rescaled, const st
         rescaled = true;
     }
     return out;
+}
+
+// Decodes each texture file once per use, shares it between materials, and remembers
+// what could not be read (one warning per file).
+struct MtlTextures {
+    fs::path directory;
+    Scene& scene;
+    std::map<std::pair<std::string, int>, std::shared_ptr<const MipMap>> loaded;  // (name, use)
+
+    enum Use { Colour, Data, AlphaMask };
+
+    std::shared_ptr<const MipMap> image(const std::string& name, Use use) {
+        const auto key = std::make_pair(name, int(use));
+        if (auto it = loaded.find(key); it != loaded.end()) return it->second;
+        std::shared_ptr<const MipMap> out;
+        const fs::path file = fs::path(name).is_absolute() ? fs::path(name) : directory / name;
+        try {
+            if (!regular_file_exists(file)) throw Error(file.string(), "texture file not found");
+            Rgba8Image img = decode_image_file(file);
+            if (use == AlphaMask) {
+                bool opaque = true;
+                for (size_t i = 3; i < img.texels.size() && opaque; i += 4) opaque = img.texels[i] == 255;
+                if (opaque)  // no alpha channel: the mask is the grey level
+                    for (size_t i = 0; i < img.texels.size(); i += 4) img.texels[i + 3] = img.texels[i];
+            }
+            out = std::make_shared<const MipMap>(std::move(img), use == Colour ? ColorEncoding::Srgb : ColorEncoding::Linear,
+                                                 file.string());
+        } catch (const Error& e) {
+            scene.warnings.push_back(std::string(e.what()) + "; the material's colour is used without it");
+        }
+        loaded[key] = out;
+        return out;
+    }
+
+    TextureRef ref(const std::string& name, const tinyobj::texture_option_t& opt, Use use) {
+        TextureRef t;
+        if (name.empty()) return t;
+        t.image = image(name, use);
+        if (!t.image) return t;
+        for (int k = 0; k < 2; ++k)
+            if (!std::isfinite(opt.scale[k]) || !std::isfinite(opt.origin_offset[k]))
+                throw Error(name, "texture option -s or -o is not a finite number");
+        // uv' = uv · s + o in OBJ's v-up convention, then v flipped for the image rows.
+        t.transform.scale = Vec2(float(opt.scale[0]), -float(opt.scale[1]));
+        t.transform.offset = Vec2(float(opt.origin_offset[0]), 1.0f - float(opt.origin_offset[1]));
+        if (opt.clamp) t.wrap_s = t.wrap_t = WrapMode::ClampToEdge;
+        return t;
+    }
+};
+
+void add_textures(Material& out, const tinyobj::material_t& m, MtlTextures& textures) {
+    out.albedo_texture = textures.ref(m.diffuse_texname, m.diffuse_texopt, MtlTextures::Colour);
+    if (out.is_emissive()) out.emission_texture = textures.ref(m.emissive_texname, m.emissive_texopt, MtlTextures::Colour);
+    const bool has_norm = !m.normal_texname.empty();
+    out.normal_texture = has_norm ? textures.ref(m.normal_texname, m.normal_texopt, MtlTextures::Data)
+                                  : textures.ref(m.bump_texname, m.bump_texopt, MtlTextures::Data);
+    const float bm = float(has_norm ? m.normal_texopt.bump_multiplier : m.bump_texopt.bump_multiplier);
+    out.normal_scale = std::isfinite(bm) ? bm : 1.0f;
+    out.alpha = std::clamp(std::isfinite(m.dissolve) ? float(m.dissolve) : 1.0f, 0.0f, 1.0f);
+    out.alpha_texture = textures.ref(m.alpha_texname, m.alpha_texopt, MtlTextures::AlphaMask);
+    if (out.alpha_texture) out.alpha_mode = AlphaMode::Mask;
 }
 
 struct CornerKey {
@@ -99,13 +171,13 @@ Scene load_obj(const fs::path& path) {
     if (reader.Warning().find("not found") != std::string::npos)
         scene.warnings.push_back(file + ": material library not found; using the default material");
 
-    bool rescaled = false, textured = false;
+    bool rescaled = false;
+    MtlTextures textures{path.parent_path(), scene, {}};
     for (const auto& m : materials) {
         scene.materials.push_back(convert_material(m, rescaled, file));
-        textured |= !m.diffuse_texname.empty() || !m.specular_texname.empty();
+        add_textures(scene.materials.back(), m, textures);
     }
     if (rescaled) scene.warnings.push_back(file + ": Kd + Ks > 1 in some materials; Ks scaled down to conserve energy");
-    if (textured) scene.warnings.push_back(file + ": textures are not used; the MTL colours stand in for them");
 
     // Index checks first, with the OBJ line of the offending face.
     size_t face_ordinal = 0;

@@ -13,7 +13,7 @@ namespace gilab {
 namespace {
 
 // Probability of sampling the glossy lobe: proportional to the lobes' peak reflectance.
-float glossy_probability(const Material& m) {
+float glossy_probability(const SurfaceMaterial& m) {
     if (!m.has_glossy_lobe()) return 0.0f;
     float d = max_component(m.albedo), s = max_component(m.specular);
     return d + s > 0.0f ? s / (d + s) : 0.0f;
@@ -30,19 +30,19 @@ float phong_lobe_pdf(float cos_a, float exponent) {
 
 }  // namespace
 
-Vec3 bsdf_eval(const Material& m, const Vec3& n, const Vec3& wo, const Vec3& wi) {
+Vec3 bsdf_eval(const SurfaceMaterial& m, const Vec3& n, const Vec3& wo, const Vec3& wi) {
     if (glm::dot(n, wo) <= 0.0f || glm::dot(n, wi) <= 0.0f) return Vec3(0.0f);
     return m.albedo * kInvPi + bsdf_glossy(m, n, wo, wi);
 }
 
-Vec3 bsdf_glossy(const Material& m, const Vec3& n, const Vec3& wo, const Vec3& wi) {
+Vec3 bsdf_glossy(const SurfaceMaterial& m, const Vec3& n, const Vec3& wo, const Vec3& wi) {
     if (!m.has_glossy_lobe() || glm::dot(n, wo) <= 0.0f || glm::dot(n, wi) <= 0.0f) return Vec3(0.0f);
     float ca = cos_alpha(n, wo, wi);
     if (!(ca > 0.0f)) return Vec3(0.0f);
     return m.specular * ((m.phong_exponent + 2.0f) * (0.5f * kInvPi) * std::pow(ca, m.phong_exponent));
 }
 
-float bsdf_pdf(const Material& m, const Vec3& n, const Vec3& wo, const Vec3& wi) {
+float bsdf_pdf(const SurfaceMaterial& m, const Vec3& n, const Vec3& wo, const Vec3& wi) {
     float cos_o = glm::dot(n, wo), cos_i = glm::dot(n, wi);
     if (cos_o <= 0.0f || cos_i <= 0.0f) return 0.0f;
     float ps = glossy_probability(m);
@@ -51,7 +51,7 @@ float bsdf_pdf(const Material& m, const Vec3& n, const Vec3& wo, const Vec3& wi)
     return pdf;
 }
 
-BsdfSample bsdf_sample(const Material& m, const Vec3& n, const Vec3& wo, Rng& rng) {
+BsdfSample bsdf_sample(const SurfaceMaterial& m, const Vec3& n, const Vec3& wo, Rng& rng) {
     BsdfSample s;
     float choice = rng.uniform();
     Vec2 u = rng.uniform2();

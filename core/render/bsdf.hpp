@@ -14,13 +14,13 @@ struct BsdfSample {
     bool valid = false;
 };
 
-Vec3 bsdf_eval(const Material& m, const Vec3& n, const Vec3& wo, const Vec3& wi);  // f (no cos)
-float bsdf_pdf(const Material& m, const Vec3& n, const Vec3& wo, const Vec3& wi);
-BsdfSample bsdf_sample(const Material& m, const Vec3& n, const Vec3& wo, Rng& rng);
+Vec3 bsdf_eval(const SurfaceMaterial& m, const Vec3& n, const Vec3& wo, const Vec3& wi);  // f (no cos)
+float bsdf_pdf(const SurfaceMaterial& m, const Vec3& n, const Vec3& wo, const Vec3& wi);
+BsdfSample bsdf_sample(const SurfaceMaterial& m, const Vec3& n, const Vec3& wo, Rng& rng);
 // Only the view-independent (Lambertian) part, ρ_d/π.
-inline Vec3 bsdf_diffuse(const Material& m) { return m.albedo * kInvPi; }
+inline Vec3 bsdf_diffuse(const SurfaceMaterial& m) { return m.albedo * kInvPi; }
 // Only the view-dependent glossy lobe (zero when either direction is below the surface);
 // bsdf_eval = bsdf_diffuse + bsdf_glossy above the surface.
-Vec3 bsdf_glossy(const Material& m, const Vec3& n, const Vec3& wo, const Vec3& wi);
+Vec3 bsdf_glossy(const SurfaceMaterial& m, const Vec3& n, const Vec3& wo, const Vec3& wi);
 
 }  // namespace gilab

@@ -107,7 +107,7 @@ Vec3 DirectLighting::irradiance(const RayTracer& tracer, const Vec3& p, const Ve
     return accumulate(tracer, p, n, offset, rng, [&](const Vec3& wi) { return Vec3(std::max(0.0f, glm::dot(n, wi))); });
 }
 
-Vec3 DirectLighting::reflected(const RayTracer& tracer, const Material& m, const Vec3& p, const Vec3& n,
+Vec3 DirectLighting::reflected(const RayTracer& tracer, const SurfaceMaterial& m, const Vec3& p, const Vec3& n,
                                const Vec3& ng, const Vec3& wo, float offset, Rng& rng) const {
     return accumulate(tracer, p, ng, offset, rng, [&](const Vec3& wi) {
         float c = glm::dot(n, wi);

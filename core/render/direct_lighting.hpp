@@ -34,7 +34,7 @@ public:
     Vec3 irradiance(const RayTracer& tracer, const Vec3& p, const Vec3& n, float offset, Rng& rng) const;
     // Reflected radiance towards wo: Σ f(wo, wi) L_i cos θ_i for material m, shading
     // normal n and geometric normal ng (both on wo's side); rays start at p + offset·ng.
-    Vec3 reflected(const RayTracer& tracer, const Material& m, const Vec3& p, const Vec3& n, const Vec3& ng,
+    Vec3 reflected(const RayTracer& tracer, const SurfaceMaterial& m, const Vec3& p, const Vec3& n, const Vec3& ng,
                    const Vec3& wo, float offset, Rng& rng) const;
 
     // irradiance() as shadow queries appended to `out` (same rays, same random numbers):

@@ -45,6 +45,21 @@ SurfaceInteraction make_interaction(const SceneFrame& frame, const Ray& ray, con
     si.back_face = glm::dot(ng, si.wo) < 0.0f;
     si.geometric_normal = si.back_face ? -ng : ng;
 
+    si.distance = hit.t;
+    for (int k = 0; k < kUvSetCount; ++k) {
+        const std::vector<Vec2>& uvs = mesh.uv_set(k);
+        if (uvs.size() != mesh.positions.size()) continue;
+        const Vec2 &t0 = uvs[tri.x], &t1 = uvs[tri.y], &t2 = uvs[tri.z];
+        si.uv[k] = b0 * t0 + b1 * t1 + b2 * t2;
+        const Vec2 d1 = t1 - t0, d2 = t2 - t0;
+        const float det = d1.x * d2.y - d1.y * d2.x;
+        if (!(std::abs(det) > 0.0f) || !(len > 0.0f)) continue;
+        const Vec3 e1 = p1 - p0, e2 = p2 - p0;
+        si.dpdu[k] = (d2.y * e1 - d1.y * e2) / det;
+        si.dpdv[k] = (d1.x * e2 - d2.x * e1) / det;
+        si.uv_per_length[k] = std::sqrt(std::abs(det) / len);
+    }
+
     si.shading_normal = si.geometric_normal;
     if (!mesh.normals.empty()) {
         Vec3 ns = b0 * mesh.normals[tri.x] + b1 * mesh.normals[tri.y] + b2 * mesh.normals[tri.z];

@@ -13,6 +13,14 @@ struct SurfaceInteraction {
     uint32_t material = 0;
     uint32_t mesh = kInvalidId, triangle = kInvalidId;
     bool back_face = false;     // the ray hit the side opposite the triangle's winding normal
+    float distance = 0;         // along the ray, in units of its direction's length
+
+    // Texture coordinates of each UV set at the hit, with the triangle's tangents along
+    // them (world length per UV unit) and its UV units per world length (the square root
+    // of UV area over world area; 0 when the mesh has no such set or it is degenerate).
+    Vec2 uv[kUvSetCount]{};
+    Vec3 dpdu[kUvSetCount]{}, dpdv[kUvSetCount]{};
+    float uv_per_length[kUvSetCount]{};
 
     // Origin for a ray leaving the surface in direction d, offset to avoid self-hits.
     Vec3 spawn_origin(const Vec3& d) const;

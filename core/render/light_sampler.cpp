@@ -17,6 +17,11 @@ Vec3 unit_or(const Vec3& v, const Vec3& fallback) {
 
 }  // namespace
 
+Vec3 EmissiveTriangle::radiance_at(const Vec2& b) const {
+    if (!texture) return radiance;
+    return radiance * Vec3(texture.sample((1.0f - b.x - b.y) * uv0 + b.x * uv1 + b.y * uv2, 0.0f));
+}
+
 LightSampler::LightSampler(const SceneFrame& frame, const std::vector<Material>& materials) {
     if (!frame.bounds.empty()) {
         scene_center_ = frame.bounds.center();
@@ -56,9 +61,20 @@ LightSampler::LightSampler(const SceneFrame& frame, const std::vector<Material>&
             e.normal = c / len;
             e.area = 0.5f * len;
             e.radiance = mat.emission;
+            Vec3 mean_radiance = e.radiance;
+            const std::vector<Vec2>& uvs = mesh.uv_set(std::clamp(mat.emission_texture.uv_set, 0, kUvSetCount - 1));
+            if (mat.emission_texture && uvs.size() == mesh.positions.size()) {
+                e.texture = mat.emission_texture;
+                e.uv0 = uvs[mesh.triangles[t].x];
+                e.uv1 = uvs[mesh.triangles[t].y];
+                e.uv2 = uvs[mesh.triangles[t].z];
+                // Selection by the image's mean (its 1 × 1 level): any positive weight is unbiased.
+                const MipMap& img = *e.texture.image;
+                mean_radiance *= Vec3(img.texel(img.levels() - 1, 0, 0, WrapMode::Repeat, WrapMode::Repeat));
+            }
             triangle_index_of_[mesh_offsets_[m] + t] = int(triangles_.size());
             triangles_.push_back(e);
-            weights.push_back(kPi * e.area * channel_average(e.radiance));
+            weights.push_back(kPi * e.area * std::max(channel_average(mean_radiance), 1e-6f * channel_average(e.radiance)));
         }
     }
 
@@ -117,7 +133,7 @@ LightSample LightSampler::triangle_incident(const EmissiveTriangle& e, const Vec
     if (cos_light <= 0.0f) return s;  // back of a one-sided emitter
     // Area pdf 1/A converted to solid angle at x.
     s.pdf = pmf * dist2 / (cos_light * e.area);
-    s.Li = e.radiance;
+    s.Li = e.radiance_at(b);
     return s;
 }
 
@@ -178,7 +194,7 @@ EmissionSample LightSampler::sample_emission(Rng& rng) const {
         s.ray.origin = p + ray_epsilon(p) * e.normal;
         s.ray.direction = glm::normalize(w);
         // Le cosθ / (pdf_A · pdf_ω) = Le cosθ · A · π / cosθ.
-        s.power = e.radiance * (kPi * e.area / pmf);
+        s.power = e.radiance_at(b) * (kPi * e.area / pmf);
         return s;
     }
     const PunctualLight& l = punctual_[index - triangles_.size()];

@@ -14,7 +14,14 @@ struct EmissiveTriangle {
     Vec3 p0{0}, p1{0}, p2{0};
     Vec3 normal{0};       // unit, winding normal; emits on this side only
     float area = 0;
-    Vec3 radiance{0};
+    Vec3 radiance{0};     // the material's emission factor
+    // An emission texture multiplies the radiance at each point, looked up at the
+    // finest level (a light sample has no footprint); uv0..uv2 are its UV set's corners.
+    TextureRef texture;
+    Vec2 uv0{0}, uv1{0}, uv2{0};
+
+    // Emitted radiance at barycentrics b (of p1 and p2).
+    Vec3 radiance_at(const Vec2& b) const;
 };
 
 // A sample of incident light at a shading point.

@@ -3,6 +3,7 @@
 #include <embree3/rtcore.h>
 #include <cstring>
 #include <vector>
+#include "core/render/surface_material.hpp"
 #include "core/util/error.hpp"
 
 namespace gilab {
@@ -51,11 +52,49 @@ Hit from_embree(const RTCRayHit& rh) {
     return h;
 }
 
+// What an alpha-tested mesh's filter reads: the world mesh and the scene's materials.
+struct AlphaMesh {
+    const WorldMesh* mesh = nullptr;
+    const std::vector<Material>* materials = nullptr;
+};
+
+bool needs_alpha_test(const WorldMesh& m, const std::vector<Material>& materials) {
+    for (uint32_t id : m.material_ids)
+        if (id < materials.size() && materials[id].alpha_tested()) return true;
+    return false;
+}
+
+// Embree filter for every query (closest hit and occlusion, single rays and streams):
+// a hit where the material's alpha mask says nothing is there is rejected, and the ray
+// goes on to the next surface.
+void alpha_filter(const RTCFilterFunctionNArguments* args) {
+    const auto* am = static_cast<const AlphaMesh*>(args->geometryUserPtr);
+    const WorldMesh& mesh = *am->mesh;
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1) continue;
+        const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+        if (prim >= mesh.triangles.size() || prim >= mesh.material_ids.size()) continue;
+        const uint32_t id = mesh.material_ids[prim];
+        if (id >= am->materials->size()) continue;
+        const Material& m = (*am->materials)[id];
+        if (!m.alpha_tested()) continue;
+        const float b1 = RTCHitN_u(args->hit, args->N, i), b2 = RTCHitN_v(args->hit, args->N, i), b0 = 1.0f - b1 - b2;
+        const UVec3 tri = mesh.triangles[prim];
+        Vec2 uv[kUvSetCount]{};
+        for (int k = 0; k < kUvSetCount; ++k) {
+            const std::vector<Vec2>& set = mesh.uv_set(k);
+            if (set.size() == mesh.positions.size()) uv[k] = b0 * set[tri.x] + b1 * set[tri.y] + b2 * set[tri.z];
+        }
+        if (!surface_present(m, uv)) args->valid[i] = 0;
+    }
+}
+
 }  // namespace
 
 struct RayTracer::Impl {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
+    std::vector<AlphaMesh> alpha_meshes;  // per geometry; stable addresses between builds
     std::vector<size_t> vertex_counts, triangle_counts;
 
     ~Impl() {
@@ -71,6 +110,7 @@ struct RayTracer::Impl {
         rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_MEDIUM);
         vertex_counts.clear();
         triangle_counts.clear();
+        alpha_meshes.assign(frame.meshes.size(), AlphaMesh{});
         for (size_t i = 0; i < frame.meshes.size(); ++i) {
             const WorldMesh& m = frame.meshes[i];
             RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -82,6 +122,12 @@ struct RayTracer::Impl {
             check_device(device, "geometry allocation");
             if (!m.positions.empty()) std::memcpy(vertices, m.positions.data(), m.positions.size() * sizeof(Vec3));
             if (!m.triangles.empty()) std::memcpy(indices, m.triangles.data(), m.triangles.size() * sizeof(UVec3));
+            alpha_meshes[i] = AlphaMesh{&m, &frame.materials};
+            if (needs_alpha_test(m, frame.materials)) {
+                rtcSetGeometryUserData(geom, &alpha_meshes[i]);
+                rtcSetGeometryIntersectFilterFunction(geom, alpha_filter);
+                rtcSetGeometryOccludedFilterFunction(geom, alpha_filter);
+            }
             rtcCommitGeometry(geom);
             // Geometry ids equal world-mesh indices: attach in order on a fresh scene.
             unsigned id = rtcAttachGeometry(scene, geom);
@@ -105,6 +151,7 @@ struct RayTracer::Impl {
 
     void refit(const SceneFrame& frame) {
         for (size_t i = 0; i < frame.meshes.size(); ++i) {
+            alpha_meshes[i] = AlphaMesh{&frame.meshes[i], &frame.materials};  // the filters read the new frame
             RTCGeometry geom = rtcGetGeometry(scene, unsigned(i));
             auto* vertices = static_cast<float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
             const auto& p = frame.meshes[i].positions;

@@ -1,6 +1,7 @@
 #include "core/render/visible_surfaces.hpp"
 
 #include "core/render/interaction.hpp"
+#include "core/render/surface_material.hpp"
 #include "core/util/parallel.hpp"
 #include "core/util/rng.hpp"
 
@@ -8,6 +9,7 @@ namespace gilab {
 
 std::vector<PixelHit> trace_visible_surfaces(const TracedScene& scene, const EyeCamera& camera, int tile_size) {
     const int width = camera.width(), height = camera.height();
+    const float spread = camera.pixel_spread_angle();
     std::vector<PixelHit> hits(size_t(width) * size_t(height));
     parallel_for_tiles(width, height, tile_size, [&](const Tile& tile) {
         for (int y = tile.y0; y < tile.y1; ++y)
@@ -16,7 +18,11 @@ std::vector<PixelHit> trace_visible_surfaces(const TracedScene& scene, const Eye
                 const Hit hit = scene.tracer().intersect(ray);
                 PixelHit& ph = hits[size_t(y) * size_t(width) + size_t(x)];
                 if (!hit.valid()) continue;
-                const SurfaceInteraction si = make_interaction(scene.frame(), ray, hit);
+                SurfaceInteraction si = make_interaction(scene.frame(), ray, hit);
+                const Material& material = scene.materials()[si.material];
+                const float width_at_hit = cone_width(spread, hit.t * glm::length(ray.direction));
+                apply_normal_map(material, si, width_at_hit);
+                ph.surface = at_surface(material, si, width_at_hit);
                 ph.hit = true;
                 ph.position = si.position;
                 ph.normal = si.shading_normal;
@@ -24,7 +30,7 @@ std::vector<PixelHit> trace_visible_surfaces(const TracedScene& scene, const Eye
                 ph.wo = si.wo;
                 ph.material = si.material;
                 ph.depth = hit.t * glm::length(ray.direction);
-                ph.emissive_front = scene.materials()[si.material].is_emissive() && !si.back_face;
+                ph.emissive_front = ph.surface.is_emissive() && !si.back_face;
             }
     });
     return hits;
@@ -46,7 +52,7 @@ void shade_direct_light(const TracedScene& scene, const DirectLighting& lighting
                 const size_t i = size_t(y) * size_t(width) + size_t(x);
                 const PixelHit& ph = hits[i];
                 if (!ph.hit) continue;
-                const Material& m = scene.materials()[ph.material];
+                const SurfaceMaterial& m = ph.surface;
                 Rng rng = Rng::for_sample(seed, i, 0, view);
                 Vec3 L = lighting.reflected(scene.tracer(), m, ph.position, ph.normal, ph.geometric_normal, ph.wo,
                                             4.0f * ray_epsilon(ph.position), rng);

@@ -16,10 +16,12 @@ struct PixelHit {
     bool emissive_front = false;  // the front of an emitter: its emission is seen
     Vec3 position{0}, normal{0}, geometric_normal{0}, wo{0};
     uint32_t material = 0;
+    SurfaceMaterial surface;  // the material with its textures looked up over the pixel's cone
     float depth = 0;  // distance along the ray
 };
 
-// One hit per pixel, row by row, in screen tiles of `tile_size`.
+// One hit per pixel, row by row, in screen tiles of `tile_size`. Textures are filtered
+// over the pixel's ray cone and normal maps bend `normal`.
 std::vector<PixelHit> trace_visible_surfaces(const TracedScene& scene, const EyeCamera& camera, int tile_size);
 
 // Writes the film's layers "direct" (direct light by shadow rays, plus the emission of

@@ -47,6 +47,9 @@ public:
     int width() const { return width_; }
     int height() const { return height_; }
     Vec3 forward() const;  // world direction of camera −Z
+    // Angle in radians one pixel subtends at the image centre: the spread of a camera
+    // ray's cone for texture filtering (ray cones, Ray Tracing Gems ch. 20).
+    float pixel_spread_angle() const { return std::atan((fov_.top - fov_.bottom) / float(height_)); }
     Mat4 view_matrix() const;                 // world → camera
     // OpenGL off-axis frustum (glFrustum of the tangents × near): NDC y points UP, while
     // pixel row 0 is the TOP row, so the row is floor(0.5 (1 − ndc.y) · height).

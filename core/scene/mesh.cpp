@@ -63,12 +63,14 @@ MeshCleanupReport validate_and_clean(Mesh& mesh, size_t material_count, const st
                 throw Error(source, label + ": vertex " + std::to_string(i) + " has a non-finite normal " +
                                         format_vec(mesh.normals[i]));
     }
-    if (!mesh.uvs.empty()) {
-        if (mesh.uvs.size() != nv)
-            throw Error(source, label + ": " + std::to_string(mesh.uvs.size()) + " texture coordinates for " +
+    for (const std::vector<Vec2>* set : {&mesh.uvs, &mesh.uvs1}) {
+        if (set->empty()) continue;
+        const std::string which = set == &mesh.uvs ? "texture coordinates" : "second-set texture coordinates";
+        if (set->size() != nv)
+            throw Error(source, label + ": " + std::to_string(set->size()) + " " + which + " for " +
                                     std::to_string(nv) + " vertices");
         for (size_t i = 0; i < nv; ++i)
-            if (!std::isfinite(mesh.uvs[i].x) || !std::isfinite(mesh.uvs[i].y))
+            if (!std::isfinite((*set)[i].x) || !std::isfinite((*set)[i].y))
                 throw Error(source, label + ": vertex " + std::to_string(i) + " has a non-finite texture coordinate");
     }
     // A mesh built without materials uses material 0 throughout.

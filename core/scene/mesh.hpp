@@ -12,7 +12,8 @@ struct Mesh {
     std::string name;
     std::vector<Vec3> positions;
     std::vector<Vec3> normals;        // per vertex, optional (empty = flat shading)
-    std::vector<Vec2> uvs;            // per vertex, optional
+    std::vector<Vec2> uvs;            // per vertex, optional (glTF TEXCOORD_0, OBJ vt)
+    std::vector<Vec2> uvs1;           // per vertex, optional second set (glTF TEXCOORD_1)
     std::vector<UVec3> triangles;     // vertex indices
     std::vector<uint32_t> material_ids;  // one per triangle, index into Scene::materials
     std::vector<VertexInfluences> influences;  // per vertex, for skinning (empty = rigid)

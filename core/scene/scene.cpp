@@ -114,6 +114,7 @@ void place_skinned(const Mesh& mesh, std::span<const Mat4> joints, WorldMesh& wm
 SceneFrame flatten(const Scene& scene, const std::vector<Mat4>& world, double time, const std::vector<bool>* include) {
     SceneFrame frame;
     frame.time = time;
+    frame.materials = scene.materials;
     std::vector<std::vector<Mat4>> joints(scene.skins.size());  // per skin, computed on first use
     for (size_t i = 0; i < scene.nodes.size(); ++i) {
         if (include && !(*include)[i]) continue;
@@ -142,6 +143,8 @@ SceneFrame flatten(const Scene& scene, const std::vector<Mat4>& world, double ti
                                 "' at non-finite world positions at t = " + number_as_given(time) +
                                 " s (its transform overflows)");
             wm.material_ids = mesh.material_ids;
+            wm.uvs = mesh.uvs;
+            wm.uvs1 = mesh.uvs1;
             frame.meshes.push_back(std::move(wm));
         }
     }

@@ -42,14 +42,18 @@ struct WorldMesh {
     uint32_t node = 0;
     std::vector<Vec3> positions;
     std::vector<Vec3> normals;       // empty if the source mesh has none
+    std::vector<Vec2> uvs, uvs1;     // the source mesh's UV sets (empty if it has none)
     std::vector<UVec3> triangles;
     std::vector<uint32_t> material_ids;
+
+    const std::vector<Vec2>& uv_set(int k) const { return k == 0 ? uvs : uvs1; }
 };
 
 struct SceneFrame {
     double time = 0;
     std::vector<WorldMesh> meshes;
     std::vector<PunctualLight> lights;  // in world space
+    std::vector<Material> materials;    // the scene's; textures are shared, not copied
     Bounds3 bounds;
     size_t triangle_count() const;
 };

@@ -48,6 +48,23 @@ void add(Fnv1a& h, const KeyframeChannel<T>& c) {
     h.array(c.values);
 }
 
+// A texture by its content, not its address: the same image loaded twice hashes alike.
+void add(Fnv1a& h, const TextureRef& t) {
+    h.value(uint8_t(t.image != nullptr));
+    if (!t.image) return;
+    const Rgba8Image& base = t.image->level(0);
+    h.value(base.width);
+    h.value(base.height);
+    h.array(base.texels);
+    h.value(t.image->encoding());
+    h.value(t.uv_set);
+    h.value(t.transform.offset);
+    h.value(t.transform.rotation);
+    h.value(t.transform.scale);
+    h.value(t.wrap_s);
+    h.value(t.wrap_t);
+}
+
 }  // namespace
 
 std::string scene_content_hash(const Scene& scene) {
@@ -57,6 +74,7 @@ std::string scene_content_hash(const Scene& scene) {
         h.array(m.positions);
         h.array(m.normals);
         h.array(m.uvs);
+        h.array(m.uvs1);
         h.array(m.triangles);
         h.array(m.material_ids);
         h.array(m.influences);
@@ -67,6 +85,12 @@ std::string scene_content_hash(const Scene& scene) {
         h.value(m.specular);
         h.value(m.phong_exponent);
         h.value(m.emission);
+        for (const TextureRef* t : {&m.albedo_texture, &m.emission_texture, &m.normal_texture, &m.alpha_texture})
+            add(h, *t);
+        h.value(m.normal_scale);
+        h.value(m.alpha_mode);
+        h.value(m.alpha);
+        h.value(m.alpha_cutoff);
     }
     h.value(uint64_t(scene.nodes.size()));
     for (const SceneNode& n : scene.nodes) {

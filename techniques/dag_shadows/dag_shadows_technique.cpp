@@ -1,5 +1,6 @@
 #include "techniques/dag_shadows/dag_shadows_technique.hpp"
 #include <cmath>
+#include "core/render/surface_material.hpp"
 #include "core/util/error.hpp"
 #include "core/render/interaction.hpp"
 #include "core/util/parallel.hpp"
@@ -180,7 +181,9 @@ void DagShadowsTechnique::render(const ViewSet& views, std::vector<Film>& films)
         const size_t n = size_t(w) * h;
         // Pass 1: primary hits.
         std::vector<SurfaceInteraction> si(n);
+        std::vector<SurfaceMaterial> surface(n);
         std::vector<uint8_t> hit(n, 0);
+        const float spread = cam.pixel_spread_angle();
         parallel_for_tiles(w, h, settings_.tile_size, [&](const Tile& t) {
             for (int y = t.y0; y < t.y1; ++y)
                 for (int x = t.x0; x < t.x1; ++x) {
@@ -189,6 +192,9 @@ void DagShadowsTechnique::render(const ViewSet& views, std::vector<Film>& films)
                     if (!hh.valid()) continue;
                     const size_t i = size_t(y) * w + x;
                     si[i] = make_interaction(frame, r, hh);
+                    const float width = cone_width(spread, hh.t * glm::length(r.direction));
+                    apply_normal_map(materials[si[i].material], si[i], width);
+                    surface[i] = at_surface(materials[si[i].material], si[i], width);
                     hit[i] = 1;
                 }
         });
@@ -237,13 +243,13 @@ void DagShadowsTechnique::render(const ViewSet& views, std::vector<Film>& films)
         // Pass 3: shading.
         const Vec3 ambient_irradiance = l.intensity * settings_.ambient;
         for (size_t i : unlit) {
-            const Material& m = materials[si[i].material];
+            const SurfaceMaterial& m = surface[i];
             film.set("color", int(i % w), int(i / w), m.emission + m.albedo * kInvPi * ambient_irradiance);
         }
         parallel_for(points.size(), 1024, [&](size_t b, size_t e) {
             for (size_t k = b; k < e; ++k) {
                 const SurfaceInteraction& s = si[index[k]];
-                const Material& m = materials[s.material];
+                const SurfaceMaterial& m = surface[index[k]];
                 Vec3 wi(0);
                 const Vec3 E = light_irradiance(l, s.position, wi);
                 const float cos_theta = std::max(0.0f, glm::dot(s.shading_normal, wi));

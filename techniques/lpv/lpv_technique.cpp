@@ -205,7 +205,7 @@ void LpvTechnique::render(const ViewSet& views, std::vector<Film>& films) {
                     const size_t i = size_t(y) * size_t(width) + size_t(x);
                     const PixelHit& ph = view_hits[i];
                     if (!ph.hit) continue;
-                    const Material& m = scene_.materials()[ph.material];
+                    const SurfaceMaterial& m = ph.surface;
                     const Vec3 E = cascades_->irradiance(ph.position, ph.normal, settings_.dampening, settings_.gradient_dampening);
                     put(indirect, i, m.albedo * kInvPi * E);
                 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include "core/render/surface_material.hpp"
 #include "core/render/interaction.hpp"
 #include "core/render/sampling.hpp"
 #include "core/util/parallel.hpp"
@@ -52,8 +53,13 @@ void trace_map(const TracedScene& scene, int size, TexelFn&& texel, ReflectiveSh
                 const Hit& hit = hits[k];
                 if (!hit.valid()) continue;
                 const TexelRay& tr = texels[k];
-                const SurfaceInteraction si = make_interaction(scene.frame(), tr.ray, hit);
-                const Material& m = scene.materials()[si.material];
+                SurfaceInteraction si = make_interaction(scene.frame(), tr.ray, hit);
+                // The RSM texel is the VPL's footprint: textures are filtered over its width.
+                const Material& material = scene.materials()[si.material];
+                const float texel_width = std::sqrt(tr.plane_area > 0 ? tr.plane_area : tr.solid_angle * hit.t * hit.t *
+                                                                                         glm::dot(tr.ray.direction, tr.ray.direction));
+                apply_normal_map(material, si, texel_width);
+                const SurfaceMaterial m = at_surface(material, si, texel_width);
                 const float t = hit.t * glm::length(tr.ray.direction);
                 const float cos_hit = std::max(0.05f, std::abs(glm::dot(si.geometric_normal, glm::normalize(tr.ray.direction))));
                 const float area = tr.plane_area > 0 ? tr.plane_area / cos_hit : tr.solid_angle * t * t / cos_hit;

@@ -5,6 +5,7 @@
 #include "core/render/bsdf.hpp"
 #include "core/util/error.hpp"
 #include "core/render/interaction.hpp"
+#include "core/render/surface_material.hpp"
 #include "core/util/parallel.hpp"
 #include "core/util/progress.hpp"
 #include "core/util/rng.hpp"
@@ -86,8 +87,13 @@ struct Tracer {
     const LightSampler& lights;
     const PathTracerSettings& settings;
 
-    PathSample trace(Ray ray, Rng& rng, uint64_t& rays) const {
+    // `spread`: the camera ray's cone angle. The cone keeps widening at that rate along
+    // the whole path (its width is what the textures are filtered over); bounces do not
+    // widen it further, so secondary hits read sharper levels than a full ray-cone
+    // curvature term would pick (that only costs texture-cache locality, not bias).
+    PathSample trace(Ray ray, float spread, Rng& rng, uint64_t& rays) const {
         PathSample out;
+        float width = 0.0f;  // cone width at the ray's origin
         Vec3 beta(1.0f);
         float prev_pdf = 0.0f;
         Vec3 prev_position(0.0f);
@@ -96,7 +102,9 @@ struct Tracer {
             ++rays;
             if (!hit.valid()) break;  // no environment light: escaped paths carry nothing
             SurfaceInteraction si = make_interaction(frame, ray, hit);
-            const Material& m = materials[si.material];
+            width += cone_width(spread, hit.t * glm::length(ray.direction));
+            apply_normal_map(materials[si.material], si, width);
+            const SurfaceMaterial m = at_surface(materials[si.material], si, width);
             if (depth == 0) {
                 out.hit = true;
                 out.albedo = m.albedo + m.specular;
@@ -183,6 +191,7 @@ void PathTracer::render(const ViewSet& views, std::vector<Film>& films) {
         Progress progress(label, tiles);
         const int spp = settings_.spp;
         const double inv_spp = 1.0 / double(spp);
+        const float spread = camera.pixel_spread_angle();
 
         parallel_for_tiles(width, height, ts, [&](const Tile& tile) {
             uint64_t tile_rays = 0, tile_dropped = 0;
@@ -198,7 +207,7 @@ void PathTracer::render(const ViewSet& views, std::vector<Film>& films) {
                         Rng rng = Rng::for_sample(settings_.seed, pixel, uint64_t(s), uint64_t(v));
                         Vec2 jitter = settings_.jitter ? rng.uniform2() : Vec2(0.5f);
                         Ray ray = camera.generate_ray(float(x) + jitter.x, float(y) + jitter.y);
-                        PathSample ps = tracer.trace(ray, rng, tile_rays);
+                        PathSample ps = tracer.trace(ray, spread, rng, tile_rays);
                         if (!is_finite(ps.direct) || !is_finite(ps.indirect)) {
                             ++tile_dropped;  // counted and reported, never averaged in
                             continue;

@@ -96,8 +96,8 @@ Vec3& part_of(PhotonEstimate& e, bool first_hit) { return first_hit ? e.direct :
 
 }  // namespace
 
-PhotonGatherer::PhotonGatherer(const PhotonMap& map, const std::vector<Material>& materials, GatherMode mode, size_t k)
-    : map_(map), materials_(materials), mode_(mode), radius_(map.radius()), radius2_(radius_ * radius_),
+PhotonGatherer::PhotonGatherer(const PhotonMap& map, GatherMode mode, size_t k)
+    : map_(map), mode_(mode), radius_(map.radius()), radius2_(radius_ * radius_),
       inv_area_(1.0f / (kPi * radius_ * radius_)), k_(k) {
     if (!(radius_ > 0.0f))
         throw Error("photon gather", "the photon map's radius must be positive (build the map with the gather radius)");
@@ -113,7 +113,7 @@ PhotonGatherer::PhotonGatherer(const PhotonMap& map, const std::vector<Material>
     }
 }
 
-PhotonEstimate PhotonGatherer::finish(const Material& m, const PhotonEstimate& sum) const {
+PhotonEstimate PhotonGatherer::finish(const SurfaceMaterial& m, const PhotonEstimate& sum) const {
     if (m.has_glossy_lobe()) return {sum.direct * inv_area_, sum.indirect * inv_area_};
     const Vec3 f = bsdf_diffuse(m);
     return {f * (sum.direct * inv_area_), f * (sum.indirect * inv_area_)};
@@ -121,7 +121,7 @@ PhotonEstimate PhotonGatherer::finish(const Material& m, const PhotonEstimate& s
 
 PhotonEstimate PhotonGatherer::sum_over_runs(const PhotonSoAView& v, const PhotonRun* runs, size_t count, const GatherPoint& p,
                                    GatherScratch& scratch, PhotonQueryStats& stats) const {
-    const Material& m = materials_[p.material];
+    const SurfaceMaterial& m = p.surface;
     const bool glossy = m.has_glossy_lobe();
     if (mode_ == GatherMode::Radius && !glossy)
         return sum_flux_runs(v, runs, count, p.position, p.normal, radius2_, stats.visited, stats.inside);
@@ -166,7 +166,7 @@ PhotonEstimate PhotonGatherer::sum_over_runs(const PhotonSoAView& v, const Photo
 
 PhotonEstimate PhotonGatherer::estimate_parts(const GatherPoint& p, GatherScratch& scratch,
                                               PhotonQueryStats& stats) const {
-    const Material& m = materials_[p.material];
+    const SurfaceMaterial& m = p.surface;
     const bool glossy = m.has_glossy_lobe();
     if (grid_) {
         ++stats.queries;
@@ -261,7 +261,7 @@ void PhotonGatherer::estimate_group(const glm::ivec3& cell, std::span<const Gath
     for (size_t i = 0; i < points.size(); ++i) {
         const GatherPoint& p = *points[i];
         ++stats.queries;
-        out[i] = finish(materials_[p.material], sum_over_runs(view, local_runs.data(), local_runs.size(), p, scratch, stats));
+        out[i] = finish(p.surface, sum_over_runs(view, local_runs.data(), local_runs.size(), p, scratch, stats));
     }
 }
 

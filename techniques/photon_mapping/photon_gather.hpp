@@ -46,6 +46,7 @@ struct GatherPoint {
     Vec3 normal{0};       // shading normal on the viewer's side
     Vec3 wo{0};           // towards the viewer
     uint32_t material = 0;
+    SurfaceMaterial surface;  // the material at the point, textures resolved
 };
 
 // Per-thread working memory.
@@ -59,7 +60,7 @@ struct GatherScratch {
 class PhotonGatherer {
 public:
     // Throws Error if the map has no positive radius.
-    PhotonGatherer(const PhotonMap& map, const std::vector<Material>& materials, GatherMode mode, size_t k);
+    PhotonGatherer(const PhotonMap& map, GatherMode mode, size_t k);
 
     // Σ f_r ΔΦ / (π r²) at p, by part, and in total.
     PhotonEstimate estimate_parts(const GatherPoint& p, GatherScratch& scratch, PhotonQueryStats& stats) const;
@@ -83,7 +84,7 @@ public:
     float radius() const { return radius_; }
 
 private:
-    PhotonEstimate finish(const Material& m, const PhotonEstimate& sum) const;
+    PhotonEstimate finish(const SurfaceMaterial& m, const PhotonEstimate& sum) const;
     PhotonEstimate sum_over_runs(const PhotonSoAView& v, const PhotonRun* runs, size_t count, const GatherPoint& p,
                                  GatherScratch& scratch, PhotonQueryStats& stats) const;
 
@@ -91,7 +92,6 @@ private:
     const HashGridPhotonMap* grid_ = nullptr;
     const KdTreePhotonMap* kd_ = nullptr;
     const NanoflannPhotonMap* nano_ = nullptr;
-    const std::vector<Material>& materials_;
     GatherMode mode_;
     float radius_, radius2_, inv_area_;
     size_t k_;

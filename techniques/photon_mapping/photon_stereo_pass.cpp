@@ -7,6 +7,7 @@
 // right pixels, and each right pixel averages its samples as the left eye does.
 #include <mutex>
 #include <optional>
+#include "core/render/surface_material.hpp"
 #include "core/render/interaction.hpp"
 #include "core/util/parallel.hpp"
 #include "core/util/rng.hpp"
@@ -31,13 +32,14 @@ void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const E
 
     Stopwatch right_watch;
     const int width = right.width();
-    const PhotonGatherer gatherer(*map_, scene_.materials(), s.gather, size_t(s.k));
+    const PhotonGatherer gatherer(*map_, s.gather, size_t(s.k));
     const PrimaryShadingContext shading{scene_.tracer(), scene_.frame(), scene_.materials(), scene_.lights(),
                                         s.light_samples};
     float* direct = film.layer("direct").data.data();
     float* indirect = film.layer("indirect").data.data();
     float* reused_layer = film.add_layer("reused", 1).data.data();
     const Vec3 eye = right.position();
+    const float right_spread = right.pixel_spread_angle();
     // Every-hit storage: direct light is the map's first-hit part, not the light samples.
     const bool map_direct = s.storage == PhotonStorage::EveryHit;
     std::mutex merge;
@@ -59,13 +61,15 @@ void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const E
                     uint32_t source = layer.source(pixel);  // a left pixel, its hit in this sample's layer
                     bool from_left = source != StereoClaims::kNone;
                     std::optional<SurfaceInteraction> own;  // the right sample's own hit, if traced
+                    PrimaryHit mine;                          // and with its material resolved
                     if (!from_left || s.stereo.match == StereoMatch::Strict) {
                         const Vec2 at = Vec2(float(x), float(y)) + sample_offset(s.sampling, s.seed, pixel, sample, 1);
                         Ray ray = right.generate_ray(at.x, at.y);
                         Hit hit = scene_.tracer().intersect(ray);
                         if (hit.valid()) own = make_interaction(scene_.frame(), ray, hit);
-                        PrimaryHit mine;
-                        if (own) mine = primary_hit_of(*own, scene_.materials()[own->material]);
+                        if (own)
+                            mine = primary_hit_of(*own, scene_.materials()[own->material],
+                                                  cone_width(right_spread, hit.t * glm::length(ray.direction)));
                         if (from_left) {
                             from_left = same_surface_point(kept.hits[kept.slot(source, sample)], mine, right,
                                                            s.stereo.tolerance);
@@ -79,7 +83,7 @@ void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const E
                     if (from_left) {
                         const size_t k = kept.slot(source, sample);
                         const PrimaryHit& h = kept.hits[k];
-                        const Material& m = scene_.materials()[h.point.material];
+                        const SurfaceMaterial& m = h.point.surface;
                         if (s.stereo.reshade && map_direct && !m.has_glossy_lobe()) {
                             // Every-hit storage, Lambertian: the left eye's light is view-independent.
                             Ld = kept.direct[k];
@@ -106,8 +110,9 @@ void PhotonMappingTechnique::render_right_reusing(const EyeCamera& left, const E
                         ++pixel_reused;
                     } else if (own) {
                         // Nobody claimed it (or strict mode refused): shade it as an independent eye.
-                        const Material& m = scene_.materials()[own->material];
-                        PrimaryHit ph = primary_hit_of(*own, m);
+                        // `mine` holds the hit with its material resolved (the normal map already bent own's normal).
+                        PrimaryHit ph = mine;
+                        const SurfaceMaterial& m = ph.point.surface;
                         Rng rng = light_sample_stream(s.sampling, s.seed, &left, own->position, pixel, sample, 1);
                         sample_direct_light(shading, *own, rng, samples, ph);
                         Ld = direct_radiance(m, ph, own->wo, samples);

@@ -4,6 +4,7 @@
 #include "core/render/bsdf.hpp"
 #include "core/util/error.hpp"
 #include "core/render/interaction.hpp"
+#include "core/render/surface_material.hpp"
 #include "core/util/parallel.hpp"
 #include "core/util/stats.hpp"
 
@@ -28,7 +29,10 @@ uint64_t trace_one(const RayTracer& tracer, const SceneFrame& frame, const std::
         ++rays;
         if (!hit.valid()) break;
         SurfaceInteraction si = make_interaction(frame, ray, hit);
-        const Material& m = materials[si.material];
+        // Photons carry no footprint: the finest texture level at the hit.
+        const Material& material = materials[si.material];
+        apply_normal_map(material, si, 0.0f);
+        const SurfaceMaterial m = at_surface(material, si, 0.0f);
         if (hit_index >= s.first_stored_hit && (max_component(m.albedo) > 0.0f || m.has_glossy_lobe())) {
             Photon p;
             p.position = si.position;

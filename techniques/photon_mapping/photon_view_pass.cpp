@@ -8,6 +8,7 @@
 #include <mutex>
 #include <optional>
 #include <tbb/parallel_sort.h>
+#include "core/render/surface_material.hpp"
 #include "core/util/error.hpp"
 #include "core/render/interaction.hpp"
 #include "core/util/parallel.hpp"
@@ -37,11 +38,12 @@ struct SortItem {
 void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOptions& options, Film& film,
                                          PhotonQueryStats& query_stats, Stats& frame_stats) const {
     const int width = camera.width(), height = camera.height();
+    const float spread = camera.pixel_spread_angle();
     const PhotonMappingSettings& s = settings_;
     const int spp = s.sampling.spp;
-    const PhotonGatherer gatherer(*map_, scene_.materials(), s.gather, size_t(s.k));
+    const PhotonGatherer gatherer(*map_, s.gather, size_t(s.k));
     std::optional<PhotonGatherer> periphery;
-    if (periphery_map_) periphery.emplace(*periphery_map_, scene_.materials(), s.gather, size_t(s.k));
+    if (periphery_map_) periphery.emplace(*periphery_map_, s.gather, size_t(s.k));
     const PrimaryShadingContext shading{scene_.tracer(), scene_.frame(), scene_.materials(), scene_.lights(),
                                         s.light_samples};
     const size_t light_samples = shading.records_per_hit();
@@ -85,8 +87,8 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
         Hit hit = scene_.tracer().intersect(ray);
         if (hit.valid()) {
             SurfaceInteraction si = make_interaction(scene_.frame(), ray, hit);
-            const Material& m = scene_.materials()[si.material];
-            PrimaryHit ph = primary_hit_of(si, m);
+            PrimaryHit ph = primary_hit_of(si, scene_.materials()[si.material],
+                                           cone_width(spread, hit.t * glm::length(ray.direction)));
             std::span<LightSampleRecord> samples;
             if (keep) {
                 samples = keep->samples_of(kept);
@@ -96,7 +98,7 @@ void PhotonMappingTechnique::render_view(const EyeCamera& camera, const ViewOpti
             }
             Rng rng = light_sample_stream(s.sampling, s.seed, options.stream_eye, si.position, pixel, sample, options.view);
             sample_direct_light(shading, si, rng, samples, ph);
-            L = direct_radiance(m, ph, si.wo, samples);
+            L = direct_radiance(ph.point.surface, ph, si.wo, samples);
             rec.point = ph.point;
             rec.valid = true;
             if (keep) keep->hits[kept] = ph;

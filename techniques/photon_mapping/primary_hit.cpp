@@ -1,21 +1,23 @@
 #include "techniques/photon_mapping/primary_hit.hpp"
 
 #include "core/render/bsdf.hpp"
+#include "core/render/surface_material.hpp"
 
 namespace gilab {
 
-PrimaryHit primary_hit_of(const SurfaceInteraction& si, const Material& m) {
+PrimaryHit primary_hit_of(SurfaceInteraction& si, const Material& m, float cone_width) {
+    apply_normal_map(m, si, cone_width);
     PrimaryHit out;
     out.valid = true;
-    out.point = {si.position, si.shading_normal, si.wo, si.material};
+    out.point = {si.position, si.shading_normal, si.wo, si.material, at_surface(m, si, cone_width)};
     out.geometric_normal = si.geometric_normal;
-    if (m.is_emissive() && !si.back_face) out.emitted = m.emission;
+    if (out.point.surface.is_emissive() && !si.back_face) out.emitted = out.point.surface.emission;
     return out;
 }
 
 void sample_direct_light(const PrimaryShadingContext& ctx, const SurfaceInteraction& si, Rng& rng,
                          std::span<LightSampleRecord> samples, PrimaryHit& hit) {
-    const Material& m = ctx.materials[si.material];
+    const SurfaceMaterial& m = hit.point.surface;
     // A black surface reflects nothing whatever the samples say: skip its shadow rays.
     const bool reflects = max_component(m.albedo) > 0.0f || m.has_glossy_lobe();
     if (ctx.light_samples <= 0 || ctx.lights.empty() || !reflects) return;
@@ -37,7 +39,7 @@ void sample_direct_light(const PrimaryShadingContext& ctx, const SurfaceInteract
         for (int k = 0; k < ctx.light_samples; ++k) add(ctx.lights.sample_area_incident(si.position, rng), inv_n);
 }
 
-Vec3 direct_radiance(const Material& m, const PrimaryHit& hit, const Vec3& wo, std::span<const LightSampleRecord> samples) {
+Vec3 direct_radiance(const SurfaceMaterial& m, const PrimaryHit& hit, const Vec3& wo, std::span<const LightSampleRecord> samples) {
     Vec3 L = hit.emitted;
     const Vec3& n = hit.point.normal;
     if (glm::dot(n, wo) <= 0.0f) return L;  // the BSDF is zero below the shading horizon

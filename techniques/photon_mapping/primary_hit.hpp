@@ -23,7 +23,7 @@ struct LightSampleRecord {
 };
 
 struct PrimaryHit {
-    GatherPoint point;          // position, shading normal (viewer side), wo, material
+    GatherPoint point;          // position, shading normal (viewer side), wo, material and its values
     Vec3 geometric_normal{0};   // viewer side
     Vec3 emitted{0};            // emission towards the viewer (front faces only)
     Vec3 irradiance{0};         // Σ LightSampleRecord::weight: the Lambertian direct term / (ρ/π)
@@ -53,8 +53,10 @@ struct PrimaryShadingContext {
     }
 };
 
-// The geometry of a hit and the emission the viewer sees; no lighting yet.
-PrimaryHit primary_hit_of(const SurfaceInteraction& si, const Material& m);
+// The geometry of a hit and the emission the viewer sees; no lighting yet. The
+// material's textures are filtered over `cone_width` (the camera ray's cone at the hit)
+// and its normal map bends si's shading normal first.
+PrimaryHit primary_hit_of(SurfaceInteraction& si, const Material& m, float cone_width);
 
 // Next-event estimation at the hit: every punctual light exactly and light_samples area
 // samples drawn from `rng` (or, past kExactPunctualLights, light_samples samples of all
@@ -67,6 +69,6 @@ void sample_direct_light(const PrimaryShadingContext& ctx, const SurfaceInteract
 // emission + ρ/π · irradiance + Σ glossy(wo, wi) · weight. The same arithmetic for the
 // eye that traced the hit and for an eye that reuses it, so a Lambertian hit gives
 // bit-identical radiance to both.
-Vec3 direct_radiance(const Material& m, const PrimaryHit& hit, const Vec3& wo, std::span<const LightSampleRecord> samples);
+Vec3 direct_radiance(const SurfaceMaterial& m, const PrimaryHit& hit, const Vec3& wo, std::span<const LightSampleRecord> samples);
 
 }  // namespace gilab

@@ -10,6 +10,7 @@
 // iteration are stored, which the paper's grid over visible points avoids.
 #include <algorithm>
 #include <atomic>
+#include "core/render/surface_material.hpp"
 #include "core/render/bsdf.hpp"
 #include "core/util/error.hpp"
 #include "core/util/format.hpp"
@@ -34,7 +35,7 @@ struct FoundPhotons {
     DVec3 flux{0.0};
 };
 
-FoundPhotons photons_within(const HashGridPhotonMap& grid, const Material& m, const GatherPoint& p, float r) {
+FoundPhotons photons_within(const HashGridPhotonMap& grid, const SurfaceMaterial& m, const GatherPoint& p, float r) {
     FoundPhotons found;
     const PhotonSoA& v = grid.soa();
     const float r2 = r * r;
@@ -93,6 +94,7 @@ void PhotonMappingTechnique::render_progressive(const ViewSet& views, std::vecto
         Stopwatch phase;
         for (size_t v = 0; v < views.views.size(); ++v) {
             const EyeCamera& camera = views.views[v];
+            const float spread = camera.pixel_spread_angle();
             ProgressiveView& view = state[v];
             parallel_for_tiles(camera.width(), camera.height(), s.tile_size, [&](const Tile& tile) {
                 std::vector<LightSampleRecord> samples(shading.records_per_hit());
@@ -105,8 +107,9 @@ void PhotonMappingTechnique::render_progressive(const ViewSet& views, std::vecto
                         view.visible[pixel] = 0;
                         if (!hit.valid()) continue;
                         SurfaceInteraction si = make_interaction(scene_.frame(), ray, hit);
-                        const Material& m = scene_.materials()[si.material];
-                        PrimaryHit ph = primary_hit_of(si, m);
+                        PrimaryHit ph = primary_hit_of(si, scene_.materials()[si.material],
+                                                       cone_width(spread, hit.t * glm::length(ray.direction)));
+                        const SurfaceMaterial& m = ph.point.surface;
                         Rng rng = light_sample_stream(s.sampling, s.seed, nullptr, si.position, pixel, iteration, v);
                         sample_direct_light(shading, si, rng, samples, ph);
                         view.direct_sum[pixel] += DVec3(finite_or_zero(direct_radiance(m, ph, si.wo, samples), nonfinite));
@@ -147,7 +150,7 @@ void PhotonMappingTechnique::render_progressive(const ViewSet& views, std::vecto
                     if (!view.visible[i]) continue;
                     SppmPixel& px = view.pixels[i];
                     const GatherPoint& p = view.points[i];
-                    const FoundPhotons found = photons_within(grid, scene_.materials()[p.material], p, float(px.radius));
+                    const FoundPhotons found = photons_within(grid, p.surface, p, float(px.radius));
                     px.add_iteration(found.count, found.flux, g.alpha);
                 }
             });

@@ -765,7 +765,7 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
                         const size_t i = size_t(y) * size_t(width) + size_t(x);
                         const PixelHit& ph = hits[i];
                         if (!ph.hit) continue;
-                        const Material& m = scene_.materials()[ph.material];
+                        const SurfaceMaterial& m = ph.surface;
                         const SurfaceCones sc = cones_at(ph);
                         const Frame frame(ph.normal);
                         Vec3 E(0);
@@ -801,7 +801,7 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
                         const size_t i = size_t(y) * size_t(width) + size_t(x);
                         const PixelHit& ph = hits[i];
                         if (!ph.hit) continue;
-                        const Material& m = scene_.materials()[ph.material];
+                        const SurfaceMaterial& m = ph.surface;
                         if (!m.has_glossy_lobe()) continue;
                         const Vec3 r = glm::reflect(-ph.wo, ph.normal);
                         const float cos_r = glm::dot(r, ph.normal);

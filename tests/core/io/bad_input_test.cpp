@@ -376,7 +376,8 @@ TEST(MemoryBudget, LoadersRefuseFilesBeyondTheBudget) {
 
 TEST(MemoryBudget, TexturesBeyondTheBudgetAreSkippedNotDecoded) {
     const fs::path dir = test::temp_dir("bad_input_texture_budget");
-    // A PNG header declaring 4096 × 4096 pixels (128 MiB decoded at 8 bytes per pixel).
+    // A PNG header declaring 4096 × 4096 pixels (128 MiB in the decoder's buffer, 85 MiB of
+    // 8-bit mip pyramid).
     std::string png = "\x89PNG\r\n\x1a\n";
     png += std::string("\0\0\0\x0dIHDR", 8);
     png += std::string("\0\0\x10\0\0\0\x10\0\x08\x06\0\0\0\0\0\0\0", 17);
@@ -391,8 +392,12 @@ TEST(MemoryBudget, TexturesBeyondTheBudgetAreSkippedNotDecoded) {
     ScopedMemoryLimit limit(uint64_t(64) << 20);
     const Scene s = load_mesh_file(path);
     bool skipped = false;
-    for (const std::string& w : s.warnings) skipped |= w.find("4096x4096") != std::string::npos && w.find("memory limit") != std::string::npos;
+    for (const std::string& w : s.warnings)
+        skipped |= w.find("big.png") != std::string::npos && w.find("4096 × 4096") != std::string::npos &&
+                   w.find("memory limit") != std::string::npos;
     EXPECT_TRUE(skipped) << "no warning about the oversized texture";
+    ASSERT_EQ(s.materials.size(), 1u);
+    EXPECT_FALSE(s.materials[0].albedo_texture) << "a refused image leaves the material untextured";
 }
 
 }  // namespace

@@ -591,14 +591,34 @@ INSTANTIATE_TEST_SUITE_P(Manifest, RealGlb,
                                            GlbAsset{"animated/RiggedSimple.glb", 160, 188}),
                          [](const auto& info) { return fs::path(info.param.path).stem().string(); });
 
-TEST(RealGlb, CesiumManTextureTintsAlbedo) {
+TEST(RealGlb, CesiumManKeepsItsTexturePerTexel) {
     auto path = test::shared_asset("animated/CesiumMan.glb");
     if (!path) GTEST_SKIP() << "shared asset animated/CesiumMan.glb not found";
     Scene s = load_gltf(*path);
     ASSERT_FALSE(s.materials.empty());
-    // The base colour factor is white; the texture's mean colour must pull it below 1.
-    EXPECT_LT(max_component(s.materials[0].albedo), 0.9f);
-    EXPECT_GT(max_component(s.materials[0].albedo), 0.0f);
+    const Material& m = s.materials[0];
+    // The factor stays the file's (white); the texture is kept whole, not averaged into it.
+    EXPECT_EQ(m.albedo, Vec3(1.0f));
+    ASSERT_TRUE(m.albedo_texture);
+    const MipMap& img = *m.albedo_texture.image;
+    EXPECT_GT(img.width(), 1);
+    EXPECT_GT(img.height(), 1);
+    EXPECT_EQ(img.encoding(), ColorEncoding::Srgb);
+    // Its texels differ (a real texture, not a flat colour) and its mean is a darker tint.
+    float lo = 1.0f, hi = 0.0f;
+    for (int y = 0; y < img.height(); y += 7)
+        for (int x = 0; x < img.width(); x += 7) {
+            const float v = luminance(Vec3(img.texel(0, x, y, WrapMode::Repeat, WrapMode::Repeat)));
+            lo = std::min(lo, v);
+            hi = std::max(hi, v);
+        }
+    EXPECT_GT(hi - lo, 0.2f);
+    const Vec3 mean = Vec3(img.texel(img.levels() - 1, 0, 0, WrapMode::Repeat, WrapMode::Repeat));
+    EXPECT_LT(max_component(mean), 0.9f);
+    EXPECT_GT(max_component(mean), 0.0f);
+    ASSERT_FALSE(s.meshes.empty());
+    EXPECT_EQ(s.meshes[0].uvs.size(), s.meshes[0].positions.size());
+    for (const std::string& w : s.warnings) EXPECT_EQ(w.find("mean"), std::string::npos) << w;
 }
 
 // ---------------------------------------------------------------- deep node hierarchies

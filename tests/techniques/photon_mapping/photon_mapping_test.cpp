@@ -165,8 +165,7 @@ TEST(PhotonMapping, PaperTilesShareOnlyWhenEveryHitIsInOneCell) {
     // hit), then the same tile with one point moved into the neighbouring cell.
     const float r = 0.1f;
     const HashGridPhotonMap grid = uniform_grid(r);
-    const std::vector<Material> materials(1);
-    const PhotonGatherer gatherer(grid, materials, GatherMode::Radius, 32);
+    const PhotonGatherer gatherer(grid, GatherMode::Radius, 32);
     const glm::ivec3 cell = grid.cell_of(Vec3(0.5f));
     auto point_in = [&](const glm::ivec3& c, Rng& rng) {
         GatherPoint p;
@@ -262,14 +261,13 @@ TEST(PhotonMapping, PaperTilesShareOnlyWhenEveryHitIsInOneCell) {
 // The gather radius is the photon map's: the one it was built for, which a map built
 // without one (a tree queried at radii of its own) does not have.
 TEST(PhotonMapping, GatherRadiusIsTheMaps) {
-    const std::vector<Material> materials(1);
     const HashGridPhotonMap grid = uniform_grid(0.1f);
-    EXPECT_EQ(PhotonGatherer(grid, materials, GatherMode::Radius, 32).radius(), 0.1f);
+    EXPECT_EQ(PhotonGatherer(grid, GatherMode::Radius, 32).radius(), 0.1f);
     KdTreePhotonMap tree;
     tree.build({}, 0.05f);
-    EXPECT_EQ(PhotonGatherer(tree, materials, GatherMode::Knn, 32).radius(), 0.05f);
+    EXPECT_EQ(PhotonGatherer(tree, GatherMode::Knn, 32).radius(), 0.05f);
     tree.build({});
-    EXPECT_THROW(PhotonGatherer(tree, materials, GatherMode::Radius, 32), Error);
+    EXPECT_THROW(PhotonGatherer(tree, GatherMode::Radius, 32), Error);
 }
 
 TEST(PhotonMapping, TileSharedSettingReadsOldBooleans) {

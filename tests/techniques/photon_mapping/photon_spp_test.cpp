@@ -15,6 +15,7 @@
 #include "core/scene/hmd.hpp"
 #include "core/image/image_metrics.hpp"
 #include "core/render/interaction.hpp"
+#include "core/render/surface_material.hpp"
 #include "core/render/light_sampler.hpp"
 #include "core/util/parallel.hpp"
 #include "core/render/ray_tracer.hpp"
@@ -115,7 +116,7 @@ ExpectedImage expected_image(const Scene& scene, const EyeCamera& camera, const 
     const SceneFrame frame = scene.evaluate(0);
     const RayTracer tracer(frame);
     const LightSampler lights(frame, scene.materials);
-    const PhotonGatherer gatherer(t.photon_map(), scene.materials, s.gather, size_t(s.k));
+    const PhotonGatherer gatherer(t.photon_map(), s.gather, size_t(s.k));
     const PrimaryShadingContext shading{tracer, frame, scene.materials, lights, s.light_samples};
     ExpectedImage out;
     for (int y = 0; y < camera.height(); ++y)
@@ -128,9 +129,10 @@ ExpectedImage expected_image(const Scene& scene, const EyeCamera& camera, const 
                 const Ray ray = camera.generate_ray(float(x) + at.x, float(y) + at.y);
                 const Hit hit = tracer.intersect(ray);
                 if (!hit.valid()) continue;
-                const SurfaceInteraction si = make_interaction(frame, ray, hit);
-                const Material& m = scene.materials[si.material];
-                PrimaryHit ph = primary_hit_of(si, m);
+                SurfaceInteraction si = make_interaction(frame, ray, hit);
+                PrimaryHit ph = primary_hit_of(si, scene.materials[si.material],
+                                               cone_width(camera.pixel_spread_angle(), hit.t * glm::length(ray.direction)));
+                const SurfaceMaterial& m = ph.point.surface;
                 std::vector<LightSampleRecord> samples(shading.records_per_hit());
                 sample_direct_light(shading, si, rng, samples, ph);
                 direct += DVec3(direct_radiance(m, ph, si.wo, samples));

@@ -241,7 +241,7 @@ std::vector<PrimaryHit> left_hits(const SceneFrame& frame, const std::vector<Mat
             Hit hit = tracer.intersect(ray);
             if (!hit.valid()) continue;
             SurfaceInteraction si = make_interaction(frame, ray, hit);
-            hits[size_t(y) * size_t(left.width()) + size_t(x)] = primary_hit_of(si, materials[si.material]);
+            hits[size_t(y) * size_t(left.width()) + size_t(x)] = primary_hit_of(si, materials[si.material], 0.0f);
         }
     return hits;
 }
