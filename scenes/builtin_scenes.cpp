@@ -3,6 +3,7 @@
 #include <array>
 #include <map>
 #include "scenes/fire_scene.hpp"
+#include "scenes/procedural_textures.hpp"
 #include "scenes/villa_and_terrain.hpp"
 
 namespace gilab {
@@ -104,6 +105,49 @@ Scene make_cornell_box() {
     return scene;
 }
 
+Scene make_textured_cornell_box() {
+    Scene scene = make_cornell_box();
+    scene.name = "cornell_textured";
+    scene.source = "builtin:cornell_textured";
+    auto texture = [](Rgba8Image image, ColorEncoding encoding, const std::string& name) {
+        TextureRef t;
+        t.image = std::make_shared<const MipMap>(std::move(image), encoding, "builtin:" + name);
+        return t;
+    };
+    Material checker = diffuse("checker", Vec3(1.0f));
+    checker.albedo_texture = texture(checkerboard_image(8, 16, Vec3(0.8f), Vec3(0.05f, 0.08f, 0.35f)), ColorEncoding::Srgb,
+                                     "checkerboard");
+    Material floor = scene.materials[0];
+    floor.name = "rippled floor";
+    RippleNormalMap ripples;
+    ripples.ripples = 8;
+    floor.normal_texture = texture(ripples.image(256), ColorEncoding::Linear, "ripples");
+    Material leaf = diffuse("leaf", Vec3(0.25f, 0.45f, 0.12f));
+    leaf.alpha_mode = AlphaMode::Mask;
+    leaf.alpha_texture = texture(leaf_mask_image(256), ColorEncoding::Linear, "leaf_mask");
+    const uint32_t checker_id = uint32_t(scene.materials.size());
+    scene.materials.insert(scene.materials.end(), {checker, floor, leaf});
+
+    // make_cornell_box adds quads of 4 vertices and 2 triangles each: floor, ceiling, back wall, ...
+    Mesh& box = scene.meshes[0];
+    const Vec2 corners[4] = {Vec2(0, 1), Vec2(1, 1), Vec2(1, 0), Vec2(0, 0)};
+    box.uvs.resize(box.positions.size());
+    for (size_t i = 0; i < box.uvs.size(); ++i) box.uvs[i] = corners[i % 4];
+    box.material_ids[0] = box.material_ids[1] = checker_id + 1;  // floor
+    box.material_ids[4] = box.material_ids[5] = checker_id;      // back wall
+
+    Mesh panel;
+    panel.name = "leaf_panel";
+    const float y = 450.0f, lo = 170.0f, hi = 390.0f;
+    for (const Vec3& p : {Vec3(hi, y, lo), Vec3(lo, y, lo), Vec3(lo, y, hi), Vec3(hi, y, hi)})
+        panel.positions.push_back(p * kCornellScale);
+    panel.uvs.assign(corners, corners + 4);
+    panel.triangles = {UVec3(0, 1, 2), UVec3(0, 2, 3)};
+    panel.material_ids.assign(2, checker_id + 2);
+    scene.add_mesh_instance(std::move(panel));
+    return scene;
+}
+
 Scene make_furnace_sphere(float albedo, float emission, int subdivisions) {
     // Icosphere; winding normals point inwards so the (one-sided) emission faces the
     // centre where the camera sits.
@@ -156,6 +200,10 @@ Scene make_furnace_sphere(float albedo, float emission, int subdivisions) {
 const std::vector<BuiltinScene>& builtin_scenes() {
     static const std::vector<BuiltinScene> scenes = {
         {"cornell", "Cornell box (original measurements, unit scale) with its ceiling area light", make_cornell_box},
+        {"cornell_textured",
+         "Cornell box with a checkerboard back wall, a normal-mapped rippled floor and an alpha-masked leaf panel under "
+         "the light",
+         make_textured_cornell_box},
         {"furnace", "white furnace: inside a closed sphere, albedo 0.5, emission 1 (radiance 2 everywhere)",
          [] { return make_furnace_sphere(0.5f, 1.0f); }},
         {"villa", "walled villa, ~40 m (walls, gate, towers, keep, gable roofs) on a slab; every mesh closed; sun",

@@ -12,6 +12,13 @@ namespace gilab {
 // and blocks (five faces per block), plus the two-triangle ceiling light.
 Scene make_cornell_box();
 
+// The Cornell box with textures that show each material feature: a checkerboard back
+// wall (material "checker", base colour texture), a rippled floor ("rippled floor", a
+// normal map: RippleNormalMap's defaults, 8 ripples across) and a horizontal panel of
+// four leaves hanging under the light ("leaf", an alpha mask tested at 0.5), whose
+// patterned shadow falls on the floor and the blocks. Every quad's UVs span [0, 1]².
+Scene make_textured_cornell_box();
+
 // A closed sphere seen from inside, uniform albedo and emission: the white furnace.
 Scene make_furnace_sphere(float albedo, float emission, int subdivisions = 3);
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <set>
 #include <string>
 #include "core/util/error.hpp"
 #include "core/util/format.hpp"
@@ -52,6 +53,20 @@ size_t Scene::triangle_count() const {
     for (const auto& node : nodes)
         for (uint32_t m : node.meshes) n += meshes[m].triangles.size();
     return n;
+}
+
+TextureUse Scene::texture_use() const {
+    TextureUse use;
+    std::set<const MipMap*> seen;
+    for (const Material& m : materials) {
+        use.textured_materials += m.has_textures();
+        for (const TextureRef* t : {&m.albedo_texture, &m.emission_texture, &m.normal_texture, &m.alpha_texture})
+            if (*t && seen.insert(t->image.get()).second) {
+                ++use.images;
+                use.bytes += t->image->bytes();
+            }
+    }
+    return use;
 }
 
 bool Scene::has_emitters() const {

@@ -58,6 +58,14 @@ struct SceneFrame {
     size_t triangle_count() const;
 };
 
+// The texture images a scene's materials use: each counted once however many materials
+// share it, with every mip level's bytes.
+struct TextureUse {
+    size_t images = 0;
+    uint64_t bytes = 0;
+    size_t textured_materials = 0;
+};
+
 // More frames than this is a mistyped rate or key time, not an animation to step through.
 inline constexpr int kMaxAnimationFrames = 1000000;
 
@@ -83,6 +91,7 @@ struct Scene {
     int animation_frame_count() const;     // frames at frames_per_second, ≥ 1 (validate() bounds it)
     size_t triangle_count() const;         // over all instances
     bool has_emitters() const;             // any emissive triangle or punctual light
+    TextureUse texture_use() const;
 
     // World-space geometry and lights at time t (seconds) / at frame k. A skinned node's
     // meshes follow its joints by linear blend skinning; the node's own transform is

@@ -20,6 +20,10 @@ uint8_t encode(float linear, bool srgb) {
     return uint8_t(std::lround((srgb ? srgb_encode(v) : v) * 255.0f));
 }
 
+// a + t (b − a): equal ends give exactly that value, so a constant texture reads back
+// its texel value bit for bit wherever it is sampled.
+Vec4 lerp(const Vec4& a, const Vec4& b, float t) { return a + t * (b - a); }
+
 int wrap(int i, int n, WrapMode mode) {
     switch (mode) {
         case WrapMode::ClampToEdge: return std::clamp(i, 0, n - 1);
@@ -107,9 +111,9 @@ Vec4 MipMap::bilinear(int level, Vec2 st, WrapMode wrap_s, WrapMode wrap_t) cons
     const float limit = 1e8f;
     const int x0 = int(std::clamp(fx, -limit, limit)), y0 = int(std::clamp(fy, -limit, limit));
     const float dx = x - fx, dy = y - fy;
-    return (1 - dx) * (1 - dy) * texel(level, x0, y0, wrap_s, wrap_t) +
-           dx * (1 - dy) * texel(level, x0 + 1, y0, wrap_s, wrap_t) +
-           (1 - dx) * dy * texel(level, x0, y0 + 1, wrap_s, wrap_t) + dx * dy * texel(level, x0 + 1, y0 + 1, wrap_s, wrap_t);
+    const Vec4 top = lerp(texel(level, x0, y0, wrap_s, wrap_t), texel(level, x0 + 1, y0, wrap_s, wrap_t), dx);
+    const Vec4 bottom = lerp(texel(level, x0, y0 + 1, wrap_s, wrap_t), texel(level, x0 + 1, y0 + 1, wrap_s, wrap_t), dx);
+    return lerp(top, bottom, dy);
 }
 
 Vec4 MipMap::trilinear(Vec2 st, float lod, WrapMode wrap_s, WrapMode wrap_t) const {
@@ -119,7 +123,7 @@ Vec4 MipMap::trilinear(Vec2 st, float lod, WrapMode wrap_s, WrapMode wrap_t) con
     const int below = int(lod);
     const float f = lod - float(below);
     const Vec4 a = bilinear(below, st, wrap_s, wrap_t);
-    return f == 0.0f ? a : glm::mix(a, bilinear(below + 1, st, wrap_s, wrap_t), f);
+    return f == 0.0f ? a : lerp(a, bilinear(below + 1, st, wrap_s, wrap_t), f);
 }
 
 float MipMap::level_for_footprint(float footprint) const {

@@ -5,8 +5,9 @@
 // always linear. Lookups return linear values.
 //
 // Level k + 1 is a box filter of level k in linear space: each texel averages the 2 × 2
-// texels below it (the last row or column of an odd-sized level folds a third texel in),
-// so every level keeps the image's mean. Sizes halve, rounding down, to 1 × 1.
+// texels below it (the last row or column of an odd-sized level folds a third texel in,
+// which then weighs a little less than the others), so every level keeps the image's mean
+// up to 8-bit rounding. Sizes halve, rounding down, to 1 × 1.
 #include <cstdint>
 #include <string>
 #include <vector>

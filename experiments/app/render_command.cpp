@@ -361,6 +361,10 @@ std::string describe_scene(const std::string& spec, const AssetPaths& assets) {
     size_t emissive = 0;
     for (const auto& m : s.materials) emissive += m.is_emissive();
     out << " (" << emissive << " emissive)\n";
+    const TextureUse textures = s.texture_use();
+    out << "textures     " << textures.images << (textures.images == 1 ? " image, " : " images, ") << format_number(double(textures.bytes) / 1e6, 2)
+        << " MB with mip levels, used by " << textures.textured_materials
+        << (textures.textured_materials == 1 ? " material\n" : " materials\n");
     out << "lights       " << s.lights.size() << " punctual";
     for (const auto& l : s.lights) out << " [" << to_string(l.type) << (l.name.empty() ? "" : " " + l.name) << "]";
     out << "\n";
