@@ -11,6 +11,7 @@
 #include <tbb/parallel_sort.h>
 #include "core/util/error.hpp"
 #include "core/util/stats.hpp"
+#include "core/voxel/box_clip.hpp"
 
 namespace gilab {
 
@@ -22,32 +23,6 @@ const char* face_name(int face) {
 namespace {
 
 constexpr int kBrick = 8;  // voxels per brick side: one task fuses one brick
-constexpr int kMaxPolygon = 12;
-
-struct Polygon {
-    int n = 0;
-    DVec3 v[kMaxPolygon];
-};
-
-// Keeps the part of `in` with sign·(x[axis] − bound) ≥ 0.
-void clip(const Polygon& in, Polygon& out, int axis, double bound, double sign) {
-    out.n = 0;
-    if (in.n == 0) return;
-    for (int i = 0; i < in.n; ++i) {
-        const DVec3& a = in.v[i];
-        const DVec3& b = in.v[i + 1 == in.n ? 0 : i + 1];
-        double da = sign * (a[axis] - bound), db = sign * (b[axis] - bound);
-        if (da >= 0) out.v[out.n++] = a;
-        if ((da >= 0) != (db >= 0)) {  // the edge crosses the plane
-            double t = da / (da - db);
-            DVec3 p = a + t * (b - a);
-            p[axis] = bound;  // exactly on the plane, whatever the rounding
-            out.v[out.n++] = p;
-        }
-        if (out.n >= kMaxPolygon - 1) break;  // convex polygon clipped by 6 planes: ≤ 9 vertices
-    }
-}
-
 // Per-voxel running sums, per axis: faces +k and −k weigh a fragment alike (A·|n_k|);
 // they differ only in the normal's orientation and in which side emits.
 struct AxisSums {
@@ -324,23 +299,10 @@ void FragmentVoxelizer::run(const VoxelLattice& lattice, std::span<const VoxelBo
                                 centroid = t.centroid;
                             } else {
                                 ++clips;
-                                Polygon a, c;
-                                a.n = 3;
-                                a.v[0] = t.p[0];
-                                a.v[1] = t.p[1];
-                                a.v[2] = t.p[2];
-                                for (int k = 0; k < 3 && a.n > 0; ++k) {
-                                    clip(a, c, k, vmin[k], 1.0);
-                                    clip(c, a, k, vmax[k], -1.0);
-                                }
-                                if (a.n < 3) continue;
-                                for (int i = 1; i + 1 < a.n; ++i) {
-                                    double s = 0.5 * std::abs(glm::dot(glm::cross(a.v[i] - a.v[0], a.v[i + 1] - a.v[0]), t.normal));
-                                    area += s;
-                                    centroid += s * (a.v[0] + a.v[i] + a.v[i + 1]) / 3.0;
-                                }
-                                if (!(area > 0)) continue;
-                                centroid /= area;
+                                const BoxPiece piece = clip_triangle_to_box(t.p, t.normal, vmin, vmax);
+                                if (!(piece.area > 0)) continue;
+                                area = piece.area;
+                                centroid = piece.centroid;
                             }
                             Vec3 albedo = t.albedo, emission = t.emission;
                             if (t.textured >= 0) {

@@ -14,6 +14,7 @@
 #include "core/util/morton.hpp"
 #include "core/scene/scene.hpp"
 #include "core/util/stats.hpp"
+#include "core/voxel/box_clip.hpp"
 
 namespace gilab {
 namespace {
@@ -182,11 +183,40 @@ std::string gib(double bytes) {
 
 UVec3 VoxelList::voxel(size_t i) const { return morton_decode(codes[i]); }
 
+// An alpha-masked triangle in voxel units, with what its mask lookups need.
+struct MaskedTriangle {
+    DVec3 p[3];
+    DVec3 normal{0};
+    Vec2 uv[3];
+    float uv_per_voxel = 0;  // UV units per voxel length
+    TextureRef mask;         // null: the alpha factor alone decides
+    float alpha = 1, cutoff = 0.5f;
+};
+
+bool mask_reaches(const MaskedTriangle& m, int64_t x, int64_t y, int64_t z) {
+    const DVec3 lo{double(x), double(y), double(z)};
+    const BoxPiece piece = clip_triangle_to_box(m.p, m.normal, lo, lo + DVec3(1.0));
+    if (!(piece.area > 0)) return false;
+    if (!m.mask) return m.alpha >= m.cutoff;
+    const DVec3 e1 = m.p[1] - m.p[0], e2 = m.p[2] - m.p[0], d = piece.centroid - m.p[0];
+    const double d11 = glm::dot(e1, e1), d12 = glm::dot(e1, e2), d22 = glm::dot(e2, e2), den = d11 * d22 - d12 * d12;
+    if (!(den > 0)) return m.alpha >= m.cutoff;
+    const float b1 = float((d22 * glm::dot(d, e1) - d12 * glm::dot(d, e2)) / den);
+    const float b2 = float((d11 * glm::dot(d, e2) - d12 * glm::dot(d, e1)) / den);
+    const Vec2 uv = (1.0f - b1 - b2) * m.uv[0] + b1 * m.uv[1] + b2 * m.uv[2];
+    const float footprint = float(std::sqrt(piece.area)) * m.uv_per_voxel;
+    const float a = m.alpha * m.mask.sample(uv, footprint).w;
+    const float lod = footprint > 0 ? m.mask.image->level_for_footprint(footprint * m.mask.transform.max_stretch()) : 0.0f;
+    return lod <= 0.0f ? a >= m.cutoff : a > 0.0f;
+}
+
 struct Voxelizer::Impl {
     VoxelGrid grid;
     VoxelizeOptions options;
     std::vector<PreparedTriangle> triangles;  // in voxel units
     std::vector<double> estimate;             // per triangle, voxels
+    std::vector<int32_t> masked;              // per triangle: index into masks, or −1 (empty: none masked)
+    std::vector<MaskedTriangle> masks;
 
     void init(std::span<const Vec3> positions, std::span<const UVec3> tris);
     VoxelList run(VoxelRegion region) const;
@@ -319,6 +349,8 @@ VoxelList Voxelizer::Impl::run(VoxelRegion region) const {
             uint64_t tests = 0;
             for (size_t p = p0; p < p1; ++p)
                 rasterize(triangles[pairs[p].triangle], 0, 0.0, clip, tests, [&](int64_t x, int64_t y, int64_t z) {
+                    const int32_t mask = masked.empty() ? -1 : masked[pairs[p].triangle];
+                    if (mask >= 0 && !mask_reaches(masks[size_t(mask)], x, y, z)) return;
                     uint64_t local = morton_encode(uint32_t(x) - bx, uint32_t(y) - by, uint32_t(z) - bz);
                     set_bit(local >> 6, uint64_t(1) << (local & 63));
                 });
@@ -406,6 +438,33 @@ Voxelizer::Voxelizer(const SceneFrame& frame, const VoxelGrid& grid, VoxelizeOpt
         positions.insert(positions.end(), mesh.positions.begin(), mesh.positions.end());
     }
     impl_->init(positions, triangles);
+    // Alpha-masked triangles, in the order init() numbered them.
+    size_t index = 0;
+    for (const WorldMesh& mesh : frame.meshes)
+        for (size_t t = 0; t < mesh.triangles.size(); ++t, ++index) {
+            const uint32_t id = t < mesh.material_ids.size() ? mesh.material_ids[t] : 0;
+            if (id >= frame.materials.size() || !frame.materials[id].alpha_tested()) continue;
+            const Material& mat = frame.materials[id];
+            MaskedTriangle m;
+            const UVec3 tri = mesh.triangles[t];
+            for (int k = 0; k < 3; ++k) m.p[k] = impl_->grid.to_voxel_space(mesh.positions[tri[k]]);
+            const DVec3 n = glm::cross(m.p[1] - m.p[0], m.p[2] - m.p[0]);
+            const double len = glm::length(n);
+            if (!(len > 0)) continue;
+            m.normal = n / len;
+            m.alpha = mat.alpha;
+            m.cutoff = mat.alpha_cutoff;
+            const std::vector<Vec2>& uvs = mesh.uv_set(std::clamp(mat.alpha_texture.uv_set, 0, kUvSetCount - 1));
+            if (mat.alpha_texture && uvs.size() == mesh.positions.size()) {
+                m.mask = mat.alpha_texture;
+                for (int k = 0; k < 3; ++k) m.uv[k] = uvs[tri[k]];
+                const Vec2 d1 = m.uv[1] - m.uv[0], d2 = m.uv[2] - m.uv[0];
+                m.uv_per_voxel = float(std::sqrt(std::abs(double(d1.x) * d2.y - double(d1.y) * d2.x) / len));
+            }
+            if (impl_->masked.empty()) impl_->masked.assign(impl_->triangles.size(), -1);
+            impl_->masked[index] = int32_t(impl_->masks.size());
+            impl_->masks.push_back(std::move(m));
+        }
 }
 
 Voxelizer::~Voxelizer() = default;

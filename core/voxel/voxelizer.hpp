@@ -5,6 +5,12 @@
 // count. Work streams over aligned bricks of at most 64³ voxels, so memory is the
 // output list plus a few brick bitmaps — never resolution³. A sub-region of the grid
 // can be voxelized alone (cascades, and split builds that go one octree subtree at a time).
+//
+// Alpha masks (from a scene frame's materials): a masked triangle occupies a voxel only
+// where its mask leaves it there. Its part inside the voxel (clipped, core/voxel/
+// box_clip.hpp) is looked up at its centroid at the mip level of its size: occupied when
+// the mask's mean alpha there is above 0 (some opaque texel reaches the voxel), or, at
+// the finest level, when alpha ≥ the cutoff. A part of zero area (a touch) holds nothing.
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -46,7 +52,7 @@ public:
     // 2^21), no triangles, out-of-range indices or non-finite positions.
     Voxelizer(std::span<const Vec3> positions, std::span<const UVec3> triangles,
               const VoxelGrid& grid, VoxelizeOptions options = {});
-    // Every mesh of a world-space scene frame.
+    // Every mesh of a world-space scene frame, alpha masks applied.
     Voxelizer(const SceneFrame& frame, const VoxelGrid& grid, VoxelizeOptions options = {});
     ~Voxelizer();
     Voxelizer(Voxelizer&&) noexcept;
