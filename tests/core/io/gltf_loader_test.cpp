@@ -446,6 +446,103 @@ TEST(GltfLoader, MorphTargetsStayUnsupportedWithWarning) {
     EXPECT_TRUE(warned);
 }
 
+// A 4 × 4 embedded image (top rows red, bottom rows green; left half opaque, right half
+// transparent), its sampler, and materials reading it through texCoord 1 overridden by
+// KHR_texture_transform, as a mask, a normal map and an emission texture.
+TEST(GltfLoader, TexturesKeepTheirSetSamplerTransformAndMask) {
+    ModelBuilder b;
+    tinygltf::Image img;
+    img.name = "blocks";
+    img.width = img.height = 4;
+    img.component = 4;
+    img.bits = 8;
+    img.pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+    img.mimeType = "image/png";
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 4; ++x)
+            img.image.insert(img.image.end(), {uint8_t(y < 2 ? 255 : 0), uint8_t(y < 2 ? 0 : 255), 0, uint8_t(x < 2 ? 255 : 0)});
+    b.model.images.push_back(img);
+    tinygltf::Sampler sampler;
+    sampler.wrapS = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+    sampler.wrapT = TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT;
+    b.model.samplers.push_back(sampler);
+    tinygltf::Texture tex;
+    tex.source = 0;
+    tex.sampler = 0;
+    b.model.textures.push_back(tex);
+    tinygltf::Material m;
+    m.name = "masked";
+    m.pbrMetallicRoughness.baseColorTexture.index = 0;
+    m.pbrMetallicRoughness.baseColorTexture.texCoord = 1;
+    m.pbrMetallicRoughness.baseColorTexture.extensions["KHR_texture_transform"] = object(
+        {{"offset", tinygltf::Value(tinygltf::Value::Array{tinygltf::Value(0.5), tinygltf::Value(0.0)})},
+         {"scale", tinygltf::Value(tinygltf::Value::Array{tinygltf::Value(2.0), tinygltf::Value(2.0)})},
+         {"rotation", tinygltf::Value(0.25)},
+         {"texCoord", tinygltf::Value(0)}});
+    m.alphaMode = "MASK";
+    m.alphaCutoff = 0.3;
+    m.normalTexture.index = 0;
+    m.normalTexture.scale = 0.7;
+    m.emissiveFactor = {1.0, 1.0, 1.0};
+    m.emissiveTexture.index = 0;
+    m.emissiveTexture.texCoord = 1;
+    b.model.materials.push_back(m);
+    tinygltf::Material blend;
+    blend.name = "blended";
+    blend.alphaMode = "BLEND";
+    blend.pbrMetallicRoughness.baseColorTexture.index = 0;
+    b.model.materials.push_back(blend);
+    b.model.extensionsUsed.push_back("KHR_texture_transform");
+    const int quad = b.add_triangle_mesh(kQuad, kQuadIndices, 0, {}, {0, 0, 1, 0, 1, 1, 0, 1});
+    b.model.meshes[size_t(quad)].primitives[0].attributes["TEXCOORD_1"] =
+        b.floats({0, 0, 0.5f, 0, 0.5f, 0.5f, 0, 0.5f}, TINYGLTF_TYPE_VEC2, 2);
+    const int tri = b.add_triangle_mesh({0, 0, 1, 1, 0, 1, 0, 1, 1}, {}, 1, {}, {0, 0, 1, 0, 0, 1});
+    b.finish({b.add_node("quad", quad), b.add_node("tri", tri)});
+    const fs::path path = b.write(test::temp_dir("gltf_textures") / "textured.gltf", false);
+
+    const Scene s = load_gltf(path);
+    ASSERT_EQ(s.materials.size(), 2u);
+    const Material& masked = s.materials[0];
+    ASSERT_TRUE(masked.albedo_texture);
+    EXPECT_EQ(masked.albedo_texture.uv_set, 0);  // the extension's texCoord overrides 1
+    EXPECT_EQ(masked.albedo_texture.transform.offset, Vec2(0.5f, 0.0f));
+    EXPECT_EQ(masked.albedo_texture.transform.scale, Vec2(2.0f));
+    EXPECT_FLOAT_EQ(masked.albedo_texture.transform.rotation, 0.25f);
+    EXPECT_EQ(masked.albedo_texture.wrap_s, WrapMode::ClampToEdge);
+    EXPECT_EQ(masked.albedo_texture.wrap_t, WrapMode::MirroredRepeat);
+    const MipMap& image = *masked.albedo_texture.image;
+    EXPECT_EQ(image.encoding(), ColorEncoding::Srgb);
+    EXPECT_EQ(image.texel(0, 0, 0, WrapMode::Repeat, WrapMode::Repeat), Vec4(1, 0, 0, 1));
+    EXPECT_EQ(image.texel(0, 3, 3, WrapMode::Repeat, WrapMode::Repeat), Vec4(0, 1, 0, 0));
+    EXPECT_TRUE(masked.alpha_tested());
+    EXPECT_FLOAT_EQ(masked.alpha_cutoff, 0.3f);
+    EXPECT_EQ(masked.alpha_texture.image, masked.albedo_texture.image);
+    ASSERT_TRUE(masked.normal_texture);
+    EXPECT_EQ(masked.normal_texture.image->encoding(), ColorEncoding::Linear);
+    EXPECT_FLOAT_EQ(masked.normal_scale, 0.7f);
+    ASSERT_TRUE(masked.emission_texture);
+    EXPECT_EQ(masked.emission_texture.uv_set, 1);
+    EXPECT_EQ(masked.emission_texture.image, masked.albedo_texture.image) << "one image, decoded once per encoding";
+    const Material& blended = s.materials[1];
+    EXPECT_TRUE(blended.alpha_tested());
+    EXPECT_FLOAT_EQ(blended.alpha_cutoff, 0.5f);
+    bool warned = false;
+    for (const std::string& w : s.warnings) warned |= w.find("BLEND") != std::string::npos;
+    EXPECT_TRUE(warned);
+    ASSERT_EQ(s.meshes[0].uvs1.size(), s.meshes[0].positions.size());
+    EXPECT_EQ(s.meshes[0].uvs1[2], Vec2(0.5f));
+    EXPECT_EQ(s.texture_use().images, 2u);  // the sRGB and the linear reading of one file
+
+    // A transform that is not numbers is an error naming its place.
+    std::ifstream in(path);
+    nlohmann::json doc = nlohmann::json::parse(in);
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"]["offset"] = {"a", 0};
+    const fs::path bad = test::write_file(path.parent_path(), "bad_transform.gltf", doc.dump());
+    const std::string msg = test::error_of([&] { load_gltf(bad); });
+    EXPECT_NE(msg.find("/materials/0/pbrMetallicRoughness/baseColorTexture/extensions/KHR_texture_transform/offset/0"),
+              std::string::npos) << msg;
+}
+
 TEST(GltfLoader, MissingFile) {
     std::string msg = error_of([] { load_gltf("/nonexistent/model.glb"); });
     EXPECT_NE(msg.find("model.glb"), std::string::npos) << msg;

@@ -2,6 +2,7 @@
 // OBJ assets from ../shared/scenes checked against the MANIFEST's counts.
 #include <gtest/gtest.h>
 
+#include <stb/stb_image_write.h>
 #include <fstream>
 #include "core/util/error.hpp"
 #include "core/io/mesh_loaders.hpp"
@@ -57,6 +58,69 @@ TEST(ObjLoader, RoundTripPositionsIndicesAndMaterials) {
     EXPECT_EQ(lamp.emission, Vec3(10, 8, 6));
     EXPECT_TRUE(s.has_emitters());
     EXPECT_EQ(s.degenerate_triangles_dropped, 0u);
+}
+
+namespace {
+
+// A w × h RGBA PNG whose texel (x, y) is f(x, y).
+std::string png(int w, int h, const std::function<std::array<uint8_t, 4>(int, int)>& f) {
+    std::vector<uint8_t> texels;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const auto t = f(x, y);
+            texels.insert(texels.end(), t.begin(), t.end());
+        }
+    std::string out;
+    stbi_write_png_to_func([](void* c, void* d, int n) { static_cast<std::string*>(c)->append(static_cast<char*>(d), size_t(n)); },
+                           &out, w, h, 4, texels.data(), w * 4);
+    return out;
+}
+
+}  // namespace
+
+// map_Kd, map_d (grey, no alpha channel), norm with -bm, -s/-o, -clamp; the image is
+// read per texel, OBJ's v axis is flipped onto the image rows, and one decoded file
+// serves every material that names it. A missing texture is a warning naming it.
+TEST(ObjLoader, TexturesArePerTexelWithTheirOptions) {
+    auto dir = test::temp_dir("obj_textures");
+    // Left column red, right column blue; top row first in the file.
+    write_file(dir, "colour.png", png(2, 2, [](int x, int) { return std::array<uint8_t, 4>{uint8_t(x ? 0 : 255), 0, uint8_t(x ? 255 : 0), 255}; }));
+    // Grey mask: the top row open (0), the bottom row opaque (255).
+    write_file(dir, "mask.png", png(2, 2, [](int, int y) { const uint8_t g = y ? 255 : 0; return std::array<uint8_t, 4>{g, g, g, 255}; }));
+    write_file(dir, "flat.png", png(1, 1, [](int, int) { return std::array<uint8_t, 4>{128, 128, 255, 255}; }));
+    write_file(dir, "t.mtl",
+               "newmtl a\nKd 1 1 1\nmap_Kd colour.png\nmap_d mask.png\nnorm -bm 0.5 flat.png\n"
+               "newmtl b\nKd 0.5 0.5 0.5\nmap_Kd -s 2 3 1 -o 0.25 0.5 0 -clamp on colour.png\n"
+               "newmtl c\nKd 0.2 0.2 0.2\nmap_Kd nowhere.png\n");
+    Scene s = load_obj(write_file(dir, "t.obj",
+                                  "mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\n"
+                                  "usemtl a\nf 1/1 2/2 3/3\nusemtl b\nf 1/1 2/2 3/3\nusemtl c\nf 1/1 2/2 3/3\n"));
+    ASSERT_EQ(s.materials.size(), 3u);
+    const Material &a = s.materials[0], &b = s.materials[1], &c = s.materials[2];
+    ASSERT_TRUE(a.albedo_texture);
+    EXPECT_EQ(a.albedo_texture.image->encoding(), ColorEncoding::Srgb);
+    // OBJ v = 0 is the image's bottom row; u = 0 its left column.
+    const Vec4 bottom_left = a.albedo_texture.sample(Vec2(0.25f, 0.25f), 0.0f);
+    EXPECT_NEAR(bottom_left.x, 1.0f, 1e-6f);
+    EXPECT_NEAR(bottom_left.z, 0.0f, 1e-6f);
+    ASSERT_TRUE(a.alpha_tested());
+    ASSERT_TRUE(a.alpha_texture);
+    EXPECT_EQ(a.alpha_texture.sample(Vec2(0.5f, 0.25f), 0.0f).w, 1.0f);  // bottom row: opaque
+    EXPECT_EQ(a.alpha_texture.sample(Vec2(0.5f, 0.75f), 0.0f).w, 0.0f);  // top row: open
+    ASSERT_TRUE(a.normal_texture);
+    EXPECT_FLOAT_EQ(a.normal_scale, 0.5f);
+    EXPECT_EQ(a.normal_texture.image->encoding(), ColorEncoding::Linear);
+    EXPECT_EQ(b.albedo_texture.image, a.albedo_texture.image) << "one file, decoded once";
+    EXPECT_EQ(b.albedo_texture.transform.scale, Vec2(2.0f, -3.0f));
+    EXPECT_EQ(b.albedo_texture.transform.offset, Vec2(0.25f, 0.5f));
+    EXPECT_EQ(b.albedo_texture.wrap_s, WrapMode::ClampToEdge);
+    EXPECT_FALSE(b.alpha_tested());
+    EXPECT_FALSE(c.albedo_texture);
+    EXPECT_EQ(c.albedo, Vec3(0.2f));
+    bool warned = false;
+    for (const std::string& w : s.warnings) warned |= w.find("nowhere.png") != std::string::npos && w.find("not found") != std::string::npos;
+    EXPECT_TRUE(warned);
+    EXPECT_EQ(s.meshes[0].uvs.size(), s.meshes[0].positions.size());
 }
 
 TEST(ObjLoader, MissingMtlFallsBackToDefaultMaterial) {
