@@ -14,6 +14,7 @@
 #include "core/util/error.hpp"
 #include "core/util/parallel.hpp"
 #include "scenes/builtin_scenes.hpp"
+#include "tests/masked_plane.hpp"
 
 namespace gilab {
 namespace {
@@ -168,36 +169,10 @@ TEST(FragmentVoxelizer, PartialAndSlantedCoverage) {
 }
 
 // An alpha-masked, textured quad over 8 × 8 voxels whose mask and colour change at the
-// voxels' edges: a voxel exists exactly where the mask is opaque, with its check's colour.
+// voxels' edges: a voxel exists exactly where the mask is opaque, with its block's colour.
 TEST(FragmentVoxelizer, MaskedTexturedQuadHoldsOnlyItsOpaqueTexels) {
-    // 32² texels: 8 × 8 blocks of 4², one per voxel. Opaque where (bx + by) % 3 != 0;
-    // red where bx is even, blue where odd.
-    Rgba8Image img{32, 32, {}};
-    for (int y = 0; y < 32; ++y)
-        for (int x = 0; x < 32; ++x) {
-            const int bx = x / 4, by = y / 4;
-            const bool red = bx % 2 == 0;
-            img.texels.insert(img.texels.end(), {uint8_t(red ? 255 : 0), 0, uint8_t(red ? 0 : 255),
-                                                 uint8_t((bx + by) % 3 != 0 ? 255 : 0)});
-        }
-    auto image = std::make_shared<const MipMap>(img, ColorEncoding::Srgb, "blocks");
-    Material m;
-    m.albedo = Vec3(0.5f);
-    m.albedo_texture.image = image;
-    m.alpha_mode = AlphaMode::Mask;
-    m.alpha_texture.image = image;
-    SceneFrame frame;
-    WorldMesh mesh;
-    // One triangle of the plane y = 0.5 covering x, z in [0, 8] whole (no seam through the
-    // voxels); u = x / 8, v = z / 8.
-    mesh.positions = {Vec3(0, 0.5f, 0), Vec3(16, 0.5f, 0), Vec3(0, 0.5f, 16)};
-    mesh.uvs = {Vec2(0, 0), Vec2(2, 0), Vec2(0, 2)};
-    mesh.triangles = {UVec3(0, 1, 2)};
-    mesh.material_ids = {0};
-    frame.meshes.push_back(mesh);
-    frame.bounds.extend(Vec3(0));
-    frame.bounds.extend(Vec3(8, 1, 8));
-    const auto voxels = FragmentVoxelizer(frame, {m}).voxelize({DVec3(0.0), 1.0}, {IVec3(0), IVec3(8, 1, 8)});
+    const SceneFrame frame = test::masked_block_plane(0.5f, Vec3(0.5f));
+    const auto voxels = FragmentVoxelizer(frame, frame.materials).voxelize({DVec3(0.0), 1.0}, {IVec3(0), IVec3(8, 1, 8)});
     std::set<std::pair<int, int>> present;
     for (const AnisotropicVoxel& v : voxels) {
         present.insert({v.coord.x, v.coord.z});
@@ -209,7 +184,7 @@ TEST(FragmentVoxelizer, MaskedTexturedQuadHoldsOnlyItsOpaqueTexels) {
     }
     for (int z = 0; z < 8; ++z)
         for (int x = 0; x < 8; ++x)
-            EXPECT_EQ(present.count({x, z}) == 1, (x + z) % 3 != 0) << x << "," << z;
+            EXPECT_EQ(present.count({x, z}) == 1, test::masked_block_opaque(x, z)) << x << "," << z;
 }
 
 TEST(FragmentVoxelizer, WallOnALatticePlaneBelongsToOneVoxelLayer) {

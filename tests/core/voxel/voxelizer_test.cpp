@@ -11,6 +11,7 @@
 #include "core/scene/scene.hpp"
 #include "core/voxel/voxelizer.hpp"
 #include "tests/test_support.hpp"
+#include "tests/masked_plane.hpp"
 #include "tests/voxel_test_meshes.hpp"
 
 using namespace gilab;
@@ -309,21 +310,7 @@ TEST(Voxelizer, StanfordBunnyAt64MatchesPerTriangleBruteForce) {
 // conservative voxelizer keeps exactly the voxels the opaque texels reach; the same plane
 // unmasked fills all 64.
 TEST(Voxelizer, AlphaMaskedTrianglesOccupyOnlyWhereTheirMaskIsOpaque) {
-    Rgba8Image img{32, 32, {}};
-    for (int y = 0; y < 32; ++y)
-        for (int x = 0; x < 32; ++x) img.texels.insert(img.texels.end(), {255, 255, 255, uint8_t((x / 4 + y / 4) % 3 != 0 ? 255 : 0)});
-    Material m;
-    m.alpha_mode = AlphaMode::Mask;
-    m.alpha_texture.image = std::make_shared<const MipMap>(img, ColorEncoding::Linear, "blocks");
-    SceneFrame frame;
-    frame.materials = {m};
-    WorldMesh mesh;
-    // One triangle of the plane y = 4.5 covering x, z in [0, 8] whole; u = x / 8, v = z / 8.
-    mesh.positions = {Vec3(0, 4.5f, 0), Vec3(16, 4.5f, 0), Vec3(0, 4.5f, 16)};
-    mesh.uvs = {Vec2(0, 0), Vec2(2, 0), Vec2(0, 2)};
-    mesh.triangles = {UVec3(0, 1, 2)};
-    mesh.material_ids = {0};
-    frame.meshes.push_back(mesh);
+    SceneFrame frame = test::masked_block_plane(4.5f, Vec3(1.0f));
     VoxelGrid grid;
     grid.origin = Vec3(0);
     grid.extent = 8.0f;
@@ -336,7 +323,8 @@ TEST(Voxelizer, AlphaMaskedTrianglesOccupyOnlyWhereTheirMaskIsOpaque) {
         present.insert({v.x, v.z});
     }
     for (uint32_t z = 0; z < 8; ++z)
-        for (uint32_t x = 0; x < 8; ++x) EXPECT_EQ(present.count({x, z}) == 1, (x + z) % 3 != 0) << x << "," << z;
+        for (uint32_t x = 0; x < 8; ++x)
+            EXPECT_EQ(present.count({x, z}) == 1, test::masked_block_opaque(int(x), int(z))) << x << "," << z;
     frame.materials[0].alpha_mode = AlphaMode::Opaque;
     EXPECT_EQ(Voxelizer(frame, grid).voxelize().size(), 64u);
 }
