@@ -95,10 +95,13 @@ Bounds3 sequence_bounds(const Scene& scene, std::span<const double> times,
     return bounds;
 }
 
-// World-space triangles without normals or materials: all that voxelizing needs.
+// World-space triangles without normals or materials: all that voxelizing needs, and
+// the alpha masks of the masked ones.
 struct SequenceVoxelizer::TriangleSet {
     std::vector<Vec3> positions;
     std::vector<UVec3> triangles;
+    std::vector<TriangleMask> masks;  // ascending triangle
+    std::vector<int32_t> mask_of;     // per triangle: index into masks or −1; empty when none is masked
 
     // The selected nodes' world triangles at `time`.
     void gather(const Scene& scene, double time, const std::vector<bool>& selected) {
@@ -125,6 +128,8 @@ struct SequenceVoxelizer::TriangleSet {
                     throw Error(kWhat, "node " + std::to_string(mesh.node) + " has a non-finite vertex position at time " +
                                            std::to_string(frame.time));
             const uint32_t base = uint32_t(positions.size());
+            const size_t first_mask = masks.size();
+            append_triangle_masks(mesh, frame.materials, uint32_t(triangles.size()), masks);
             for (const UVec3& t : mesh.triangles) {
                 for (int k = 0; k < 3; ++k)
                     if (t[k] >= mesh.positions.size())
@@ -133,11 +138,18 @@ struct SequenceVoxelizer::TriangleSet {
                                                std::to_string(mesh.positions.size()));
                 triangles.push_back(t + UVec3(base));
             }
+            if (!masks.empty()) {  // from the first masked mesh on, every triangle has an entry
+                mask_of.resize(triangles.size(), -1);
+                for (size_t k = first_mask; k < masks.size(); ++k) mask_of[masks[k].triangle] = int32_t(k);
+            }
             positions.insert(positions.end(), mesh.positions.begin(), mesh.positions.end());
             mesh = WorldMesh();
         }
     }
-    size_t bytes() const { return positions.capacity() * sizeof(Vec3) + triangles.capacity() * sizeof(UVec3); }
+    size_t bytes() const {
+        return positions.capacity() * sizeof(Vec3) + triangles.capacity() * sizeof(UVec3) +
+               masks.capacity() * sizeof(TriangleMask) + mask_of.capacity() * sizeof(int32_t);
+    }
 };
 
 // Triangle ids per aligned cell, compact (CSR) over the cells that hold any.
@@ -279,12 +291,17 @@ std::vector<uint64_t> SequenceVoxelizer::voxelize_cell(uint64_t cell, const Fram
     // The cell's own triangles, three corners each, so the voxelizer's input checks and
     // preparation cost only this cell.
     std::vector<Vec3> corners;
+    std::vector<TriangleMask> masks;  // of the cell's triangles, by their index here (ascending)
     const auto fixed = static_bins_->of(cell);
     const auto moving = frame.dynamic_bins.of(cell);
     corners.reserve(3 * (fixed.size() + moving.size()));
     auto add = [&](const TriangleSet& set, std::span<const uint32_t> ids) {
         for (uint32_t id : ids) {
             const UVec3& t = set.triangles[id];
+            if (!set.mask_of.empty() && set.mask_of[id] >= 0) {
+                masks.push_back(set.masks[size_t(set.mask_of[id])]);
+                masks.back().triangle = uint32_t(corners.size() / 3);
+            }
             corners.insert(corners.end(), {set.positions[t.x], set.positions[t.y], set.positions[t.z]});
         }
     };
@@ -302,8 +319,14 @@ std::vector<uint64_t> SequenceVoxelizer::voxelize_cell(uint64_t cell, const Fram
     for (size_t begin = 0; begin < count; begin += kMaxVoxelizerTriangles) {
         const size_t n = std::min(kMaxVoxelizerTriangles, count - begin);
         const std::span<const Vec3> chunk(corners.data() + 3 * begin, 3 * n);
+        // This chunk's masks, renumbered from its first triangle.
+        auto by_triangle = [](const TriangleMask& m, size_t t) { return m.triangle < t; };
+        const auto m0 = std::lower_bound(masks.begin(), masks.end(), begin, by_triangle);
+        const auto m1 = std::lower_bound(m0, masks.end(), begin + n, by_triangle);
+        std::vector<TriangleMask> chunk_masks(m0, m1);
+        for (TriangleMask& m : chunk_masks) m.triangle -= uint32_t(begin);
         std::vector<uint64_t> part =
-            Voxelizer(chunk, std::span<const UVec3>(triangles.data(), n), grid_, options_).voxelize(region).codes;
+            Voxelizer(chunk, std::span<const UVec3>(triangles.data(), n), grid_, options_, chunk_masks).voxelize(region).codes;
         if (codes.empty()) {
             codes = std::move(part);
             continue;

@@ -45,7 +45,6 @@ SurfaceInteraction make_interaction(const SceneFrame& frame, const Ray& ray, con
     si.back_face = glm::dot(ng, si.wo) < 0.0f;
     si.geometric_normal = si.back_face ? -ng : ng;
 
-    si.distance = hit.t;
     for (int k = 0; k < kUvSetCount; ++k) {
         const std::vector<Vec2>& uvs = mesh.uv_set(k);
         if (uvs.size() != mesh.positions.size()) continue;

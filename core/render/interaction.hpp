@@ -13,7 +13,6 @@ struct SurfaceInteraction {
     uint32_t material = 0;
     uint32_t mesh = kInvalidId, triangle = kInvalidId;
     bool back_face = false;     // the ray hit the side opposite the triangle's winding normal
-    float distance = 0;         // along the ray, in units of its direction's length
 
     // Texture coordinates of each UV set at the hit, with the triangle's tangents along
     // them (world length per UV unit) and its UV units per world length (the square root

@@ -179,10 +179,6 @@ std::string gib(double bytes) {
     return buf;
 }
 
-}  // namespace
-
-UVec3 VoxelList::voxel(size_t i) const { return morton_decode(codes[i]); }
-
 // An alpha-masked triangle in voxel units, with what its mask lookups need.
 struct MaskedTriangle {
     DVec3 p[3];
@@ -210,6 +206,29 @@ bool mask_reaches(const MaskedTriangle& m, int64_t x, int64_t y, int64_t z) {
     return lod <= 0.0f ? a >= m.cutoff : a > 0.0f;
 }
 
+}  // namespace
+
+UVec3 VoxelList::voxel(size_t i) const { return morton_decode(codes[i]); }
+
+void append_triangle_masks(const WorldMesh& mesh, const std::vector<Material>& materials, uint32_t first_triangle,
+                           std::vector<TriangleMask>& out) {
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+        const uint32_t id = t < mesh.material_ids.size() ? mesh.material_ids[t] : 0;
+        if (id >= materials.size() || !materials[id].alpha_tested()) continue;
+        const Material& mat = materials[id];
+        TriangleMask m;
+        m.triangle = first_triangle + uint32_t(t);
+        m.alpha = mat.alpha;
+        m.cutoff = mat.alpha_cutoff;
+        const std::vector<Vec2>& uvs = mesh.uv_set(std::clamp(mat.alpha_texture.uv_set, 0, kUvSetCount - 1));
+        if (mat.alpha_texture && uvs.size() == mesh.positions.size()) {
+            m.texture = mat.alpha_texture;
+            for (int k = 0; k < 3; ++k) m.uv[k] = uvs[mesh.triangles[t][k]];
+        }
+        out.push_back(std::move(m));
+    }
+}
+
 struct Voxelizer::Impl {
     VoxelGrid grid;
     VoxelizeOptions options;
@@ -217,6 +236,8 @@ struct Voxelizer::Impl {
     std::vector<double> estimate;             // per triangle, voxels
     std::vector<int32_t> masked;              // per triangle: index into masks, or −1 (empty: none masked)
     std::vector<MaskedTriangle> masks;
+
+    void add_masks(std::span<const Vec3> positions, std::span<const UVec3> tris, std::span<const TriangleMask> input);
 
     void init(std::span<const Vec3> positions, std::span<const UVec3> tris);
     VoxelList run(VoxelRegion region) const;
@@ -411,11 +432,12 @@ VoxelList Voxelizer::Impl::run(VoxelRegion region) const {
 }
 
 Voxelizer::Voxelizer(std::span<const Vec3> positions, std::span<const UVec3> triangles, const VoxelGrid& grid,
-                     VoxelizeOptions options)
+                     VoxelizeOptions options, std::span<const TriangleMask> masks)
     : impl_(std::make_unique<Impl>()) {
     impl_->grid = grid;
     impl_->options = options;
     impl_->init(positions, triangles);
+    impl_->add_masks(positions, triangles, masks);
 }
 
 Voxelizer::Voxelizer(const SceneFrame& frame, const VoxelGrid& grid, VoxelizeOptions options)
@@ -438,33 +460,37 @@ Voxelizer::Voxelizer(const SceneFrame& frame, const VoxelGrid& grid, VoxelizeOpt
         positions.insert(positions.end(), mesh.positions.begin(), mesh.positions.end());
     }
     impl_->init(positions, triangles);
-    // Alpha-masked triangles, in the order init() numbered them.
-    size_t index = 0;
-    for (const WorldMesh& mesh : frame.meshes)
-        for (size_t t = 0; t < mesh.triangles.size(); ++t, ++index) {
-            const uint32_t id = t < mesh.material_ids.size() ? mesh.material_ids[t] : 0;
-            if (id >= frame.materials.size() || !frame.materials[id].alpha_tested()) continue;
-            const Material& mat = frame.materials[id];
-            MaskedTriangle m;
-            const UVec3 tri = mesh.triangles[t];
-            for (int k = 0; k < 3; ++k) m.p[k] = impl_->grid.to_voxel_space(mesh.positions[tri[k]]);
-            const DVec3 n = glm::cross(m.p[1] - m.p[0], m.p[2] - m.p[0]);
-            const double len = glm::length(n);
-            if (!(len > 0)) continue;
-            m.normal = n / len;
-            m.alpha = mat.alpha;
-            m.cutoff = mat.alpha_cutoff;
-            const std::vector<Vec2>& uvs = mesh.uv_set(std::clamp(mat.alpha_texture.uv_set, 0, kUvSetCount - 1));
-            if (mat.alpha_texture && uvs.size() == mesh.positions.size()) {
-                m.mask = mat.alpha_texture;
-                for (int k = 0; k < 3; ++k) m.uv[k] = uvs[tri[k]];
-                const Vec2 d1 = m.uv[1] - m.uv[0], d2 = m.uv[2] - m.uv[0];
-                m.uv_per_voxel = float(std::sqrt(std::abs(double(d1.x) * d2.y - double(d1.y) * d2.x) / len));
-            }
-            if (impl_->masked.empty()) impl_->masked.assign(impl_->triangles.size(), -1);
-            impl_->masked[index] = int32_t(impl_->masks.size());
-            impl_->masks.push_back(std::move(m));
+    std::vector<TriangleMask> masks;
+    uint32_t first = 0;
+    for (const WorldMesh& mesh : frame.meshes) {
+        append_triangle_masks(mesh, frame.materials, first, masks);
+        first += uint32_t(mesh.triangles.size());
+    }
+    impl_->add_masks(positions, triangles, masks);
+}
+
+void Voxelizer::Impl::add_masks(std::span<const Vec3> positions, std::span<const UVec3> tris,
+                                std::span<const TriangleMask> input) {
+    for (const TriangleMask& in : input) {
+        if (in.triangle >= tris.size())
+            throw Error("voxelizer", "a mask names triangle " + std::to_string(in.triangle) + " of " + std::to_string(tris.size()));
+        MaskedTriangle m;
+        for (int k = 0; k < 3; ++k) m.p[k] = grid.to_voxel_space(positions[tris[in.triangle][k]]);
+        const DVec3 n = glm::cross(m.p[1] - m.p[0], m.p[2] - m.p[0]);
+        const double len = glm::length(n);
+        m.normal = len > 0 ? n / len : DVec3(0);
+        m.alpha = in.alpha;
+        m.cutoff = in.cutoff;
+        m.mask = in.texture;
+        for (int k = 0; k < 3; ++k) m.uv[k] = in.uv[k];
+        if (in.texture && len > 0) {
+            const Vec2 d1 = m.uv[1] - m.uv[0], d2 = m.uv[2] - m.uv[0];
+            m.uv_per_voxel = float(std::sqrt(std::abs(double(d1.x) * d2.y - double(d1.y) * d2.x) / len));
         }
+        if (masked.empty()) masked.assign(triangles.size(), -1);
+        masked[in.triangle] = int32_t(masks.size());
+        masks.push_back(std::move(m));
+    }
 }
 
 Voxelizer::~Voxelizer() = default;

@@ -15,12 +15,27 @@
 #include <memory>
 #include <span>
 #include <vector>
+#include "core/scene/material.hpp"
 #include "core/util/math.hpp"
 #include "core/voxel/voxel_grid.hpp"
 
 namespace gilab {
 
 struct SceneFrame;
+struct WorldMesh;
+
+// The alpha mask of one input triangle.
+struct TriangleMask {
+    uint32_t triangle = 0;  // index into the voxelizer's triangles
+    Vec2 uv[3]{};           // the mask's UV set at the triangle's corners
+    TextureRef texture;     // null: the alpha factor alone decides
+    float alpha = 1, cutoff = 0.5f;
+};
+
+// Appends the masks of `mesh`'s alpha-tested triangles, numbered from first_triangle in
+// the mesh's triangle order.
+void append_triangle_masks(const WorldMesh& mesh, const std::vector<Material>& materials, uint32_t first_triangle,
+                           std::vector<TriangleMask>& out);
 
 struct VoxelizeOptions {
     // Output budget: a call whose estimated voxel count × 8 bytes exceeds it throws
@@ -50,8 +65,9 @@ class Voxelizer {
 public:
     // Triangles index `positions`. Throws Error for a bad grid (resolution 0 or above
     // 2^21), no triangles, out-of-range indices or non-finite positions.
+    // `masks`: alpha masks of some of the triangles, in any order.
     Voxelizer(std::span<const Vec3> positions, std::span<const UVec3> triangles,
-              const VoxelGrid& grid, VoxelizeOptions options = {});
+              const VoxelGrid& grid, VoxelizeOptions options = {}, std::span<const TriangleMask> masks = {});
     // Every mesh of a world-space scene frame, alpha masks applied.
     Voxelizer(const SceneFrame& frame, const VoxelGrid& grid, VoxelizeOptions options = {});
     ~Voxelizer();

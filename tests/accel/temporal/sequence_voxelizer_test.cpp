@@ -20,6 +20,7 @@
 #include "scenes/fire_scene.hpp"
 #include "scenes/procedural_meshes.hpp"
 #include "accel/temporal/animation_dag.hpp"
+#include "tests/masked_plane.hpp"
 #include "tests/test_support.hpp"
 #include "tests/voxel_test_meshes.hpp"
 
@@ -188,6 +189,38 @@ TEST(SequenceVoxelizer, SlicesConcatenateToTheWholeFrame) {
         const WalkCounts counts = check_sequence(scene, test_grid(), split, mixed_times());
         EXPECT_GT(counts.dirty, 0u);
     }
+}
+
+// The masked block plane (tests/masked_plane.hpp) streamed cell by cell: the same voxels
+// as the whole frame's, which hold only the opaque blocks, while a second copy of the
+// plane moves below it (so its cells are dirty).
+TEST(SequenceVoxelizer, AlphaMasksCutTheStreamedVoxelsAsTheWholeFrames) {
+    const SceneFrame plane = test::masked_block_plane(4.5f, Vec3(1.0f));
+    Scene scene;
+    scene.name = "masked_plane";
+    scene.materials = plane.materials;
+    Mesh mesh;
+    mesh.name = "plane";
+    mesh.positions = plane.meshes[0].positions;
+    mesh.uvs = plane.meshes[0].uvs;
+    mesh.triangles = plane.meshes[0].triangles;
+    mesh.material_ids = plane.meshes[0].material_ids;
+    scene.add_mesh_instance(mesh);
+    const uint32_t moving = scene.add_mesh_instance(mesh, Transform{Vec3(0, -2, 0), Quat(1, 0, 0, 0), Vec3(1)});
+    scene.nodes[moving].animation.translation.times = {0.0, 1.0};
+    scene.nodes[moving].animation.translation.values = {Vec3(0, -2, 0), Vec3(0, -3, 0)};
+    VoxelGrid grid;
+    grid.origin = Vec3(0);
+    grid.extent = 8.0f;
+    grid.resolution = 8;
+    check_sequence(scene, grid, 1, {0.0, 1.0});
+    const VoxelList whole = voxelize(scene.evaluate(0.0), grid);
+    size_t on_plane = 0, opaque = 0;
+    for (size_t i = 0; i < whole.size(); ++i) on_plane += whole.voxel(i).y == 4;
+    for (int z = 0; z < 8; ++z)
+        for (int x = 0; x < 8; ++x) opaque += test::masked_block_opaque(x, z);
+    EXPECT_EQ(on_plane, opaque);
+    EXPECT_EQ(whole.size(), 2 * opaque);  // and the moving copy at y = 2.5
 }
 
 TEST(SequenceVoxelizer, CleanCellsKeepThePreviousFramesVoxels) {
