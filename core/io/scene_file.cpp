@@ -132,7 +132,10 @@ Quat look_rotation(const Vec3& forward, const Vec3& up_hint) {
 
 bool same_material(const Material& a, const Material& b) {
     return a.name == b.name && a.albedo == b.albedo && a.specular == b.specular &&
-           a.phong_exponent == b.phong_exponent && a.emission == b.emission;
+           a.phong_exponent == b.phong_exponent && a.emission == b.emission && a.albedo_texture == b.albedo_texture &&
+           a.emission_texture == b.emission_texture && a.normal_texture == b.normal_texture &&
+           a.normal_scale == b.normal_scale && a.alpha_mode == b.alpha_mode && a.alpha == b.alpha &&
+           a.alpha_cutoff == b.alpha_cutoff && a.alpha_texture == b.alpha_texture;
 }
 
 struct SceneBuilder {

@@ -16,6 +16,7 @@ struct UvTransform {
     Vec2 scale{1.0f};
 
     bool is_identity() const { return offset == Vec2(0.0f) && rotation == 0.0f && scale == Vec2(1.0f); }
+    bool operator==(const UvTransform&) const = default;
     Vec2 apply(Vec2 uv) const;
     // How much the transform stretches a length in UV space, at most (for footprints).
     float max_stretch() const { return std::max(std::abs(scale.x), std::abs(scale.y)); }
@@ -31,6 +32,8 @@ struct TextureRef {
     WrapMode wrap_s = WrapMode::Repeat, wrap_t = WrapMode::Repeat;
 
     explicit operator bool() const { return image != nullptr; }
+    // The same image object read the same way.
+    bool operator==(const TextureRef&) const = default;
     // Linear RGBA at the mesh UV `uv` filtered over a footprint `footprint` wide in that
     // UV set's units (before the transform); footprint 0 reads the finest level.
     Vec4 sample(Vec2 uv, float footprint) const;

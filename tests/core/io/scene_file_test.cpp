@@ -3,6 +3,7 @@
 // JSON path; every shipped scene in scenes/ loads.
 #include <gtest/gtest.h>
 
+#include <stb/stb_image_write.h>
 #include <fstream>
 #include "core/util/error.hpp"
 #include "core/io/mesh_loaders.hpp"
@@ -176,6 +177,27 @@ TEST(SceneFile, FilesAreFoundThroughTheAssetSearchPath) {
     Scene s = load_scene_file(json, AssetPaths({other / "nowhere", assets}));
     EXPECT_EQ(s.meshes.size(), 1u);
     EXPECT_EQ(s.meshes[0].positions[2], Vec3(0, 4, 0));
+}
+
+// Two OBJ parts whose materials share a name and colour but not a texture stay two
+// materials.
+TEST(SceneFile, MaterialsThatDifferOnlyInTheirTextureAreNotMerged) {
+    auto dir = test::temp_dir("scene_file_textures");
+    for (const char* name : {"a", "b"}) {
+        const uint8_t grey = name[0] == 'a' ? 40 : 200;
+        const std::vector<uint8_t> texels(16, grey);
+        std::string png;
+        stbi_write_png_to_func([](void* c, void* d, int n) { static_cast<std::string*>(c)->append(static_cast<char*>(d), size_t(n)); },
+                               &png, 2, 2, 4, texels.data(), 8);
+        write_file(dir, std::string(name) + ".png", png);
+        write_file(dir, std::string(name) + ".mtl", "newmtl wall\nKd 1 1 1\nmap_Kd " + std::string(name) + ".png\n");
+        write_file(dir, std::string(name) + ".obj",
+                   "mtllib " + std::string(name) + ".mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl wall\nf 1/1 2/2 3/3\n");
+    }
+    const Scene s = load(write_file(dir, "s.json", R"({"meshes": [{"file": "a.obj"}, {"file": "b.obj"}]})"));
+    ASSERT_EQ(s.materials.size(), 2u);
+    EXPECT_NE(s.materials[0].albedo_texture.image, s.materials[1].albedo_texture.image);
+    EXPECT_NE(s.meshes[0].material_ids[0], s.meshes[1].material_ids[0]);
 }
 
 TEST(SceneFile, MissingSceneFile) {
