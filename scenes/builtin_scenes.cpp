@@ -49,13 +49,6 @@ void add_block(Mesh& mesh, const Quad& top, float height, uint32_t material) {
     }
 }
 
-Material diffuse(const std::string& name, Vec3 albedo) {
-    Material m;
-    m.name = name;
-    m.albedo = albedo;
-    return m;
-}
-
 }  // namespace
 
 Scene make_cornell_box() {
@@ -63,9 +56,9 @@ Scene make_cornell_box() {
     scene.name = "cornell";
     scene.source = "builtin:cornell";
     // Reflectances commonly used for the Cornell box in pbrt/Mitsuba test scenes.
-    scene.materials = {diffuse("white", {0.725f, 0.71f, 0.68f}), diffuse("red", {0.63f, 0.065f, 0.05f}),
-                       diffuse("green", {0.14f, 0.45f, 0.091f})};
-    Material light = diffuse("light", {0.78f, 0.78f, 0.78f});
+    scene.materials = {diffuse_material("white", {0.725f, 0.71f, 0.68f}), diffuse_material("red", {0.63f, 0.065f, 0.05f}),
+                       diffuse_material("green", {0.14f, 0.45f, 0.091f})};
+    Material light = diffuse_material("light", {0.78f, 0.78f, 0.78f});
     light.emission = Vec3(17.0f, 12.0f, 4.0f);
     scene.materials.push_back(light);
     const uint32_t white = 0, red = 1, green = 2, emitter = 3;
@@ -114,7 +107,7 @@ Scene make_textured_cornell_box() {
         t.image = std::make_shared<const MipMap>(std::move(image), encoding, "builtin:" + name);
         return t;
     };
-    Material checker = diffuse("checker", Vec3(1.0f));
+    Material checker = diffuse_material("checker", Vec3(1.0f));
     checker.albedo_texture = texture(checkerboard_image(8, 16, Vec3(0.8f), Vec3(0.05f, 0.08f, 0.35f)), ColorEncoding::Srgb,
                                      "checkerboard");
     Material floor = scene.materials[0];
@@ -122,7 +115,7 @@ Scene make_textured_cornell_box() {
     RippleNormalMap ripples;
     ripples.ripples = 8;
     floor.normal_texture = texture(ripples.image(256), ColorEncoding::Linear, "ripples");
-    Material leaf = diffuse("leaf", Vec3(0.25f, 0.45f, 0.12f));
+    Material leaf = diffuse_material("leaf", Vec3(0.25f, 0.45f, 0.12f));
     leaf.alpha_mode = AlphaMode::Mask;
     leaf.alpha_texture = texture(leaf_mask_image(256), ColorEncoding::Linear, "leaf_mask");
     const uint32_t checker_id = uint32_t(scene.materials.size());

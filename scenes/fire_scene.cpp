@@ -21,14 +21,6 @@ constexpr float kSwirl = 0.8f;             // rad/s: the column turns slowly abo
 constexpr float kMinLife = 0.5f, kMaxLife = 1.5f;  // s
 constexpr float kEndScale = 0.3f;          // scale at the end of a life (1 at birth)
 
-Material diffuse(const std::string& name, Vec3 albedo, Vec3 emission = Vec3(0)) {
-    Material m;
-    m.name = name;
-    m.albedo = albedo;
-    m.emission = emission;
-    return m;
-}
-
 // A closed regular octahedron centred on the origin, wound outwards.
 Mesh make_octahedron(float radius, uint32_t material) {
     Mesh mesh;
@@ -153,8 +145,8 @@ Scene make_fire_scene(const FireOptions& options) {
     scene.name = "fire";
     scene.source = "builtin:fire";
     scene.frames_per_second = options.fps;
-    scene.materials = {diffuse("ground", {0.35f, 0.33f, 0.3f}), diffuse("wood", {0.3f, 0.18f, 0.09f}),
-                       diffuse("ember", {0.9f, 0.5f, 0.15f}, {4.0f, 1.6f, 0.3f})};
+    scene.materials = {diffuse_material("ground", {0.35f, 0.33f, 0.3f}), diffuse_material("wood", {0.3f, 0.18f, 0.09f}),
+                       diffuse_material("ember", {0.9f, 0.5f, 0.15f}, {4.0f, 1.6f, 0.3f})};
     const uint32_t ground = 0, wood = 1, ember = 2;
 
     // A 2 m disc of ground, 2 cm thick so it is a closed solid; its top is y = 0.

@@ -10,13 +10,6 @@ namespace gilab {
 
 namespace {
 
-Material diffuse(const std::string& name, Vec3 albedo) {
-    Material m;
-    m.name = name;
-    m.albedo = albedo;
-    return m;
-}
-
 PunctualLight sun(const Vec3& direction, float intensity) {
     PunctualLight light;
     light.name = "sun";
@@ -165,8 +158,8 @@ Scene make_villa() {
     Scene scene;
     scene.name = "villa";
     scene.source = "builtin:villa";
-    scene.materials = {diffuse("stone", {0.55f, 0.52f, 0.47f}), diffuse("roof", {0.5f, 0.2f, 0.12f}),
-                       diffuse("ground", {0.3f, 0.34f, 0.24f}), diffuse("plaster", {0.75f, 0.72f, 0.64f})};
+    scene.materials = {diffuse_material("stone", {0.55f, 0.52f, 0.47f}), diffuse_material("roof", {0.5f, 0.2f, 0.12f}),
+                       diffuse_material("ground", {0.3f, 0.34f, 0.24f}), diffuse_material("plaster", {0.75f, 0.72f, 0.64f})};
     const uint32_t stone = 0, roof = 1, ground = 2, plaster = 3;
 
     // Ground: a thick slab (closed, unlike a quad) whose top face is y = 0.
@@ -226,7 +219,7 @@ Scene make_fbm_terrain(int grid) {
     Scene scene;
     scene.name = "fbm_terrain";
     scene.source = "builtin:fbm_terrain";
-    scene.materials = {diffuse("ground", {0.4f, 0.37f, 0.3f})};
+    scene.materials = {diffuse_material("ground", {0.4f, 0.37f, 0.3f})};
     scene.add_mesh_instance(make_heightfield("terrain", grid, grid, Vec2(-kTerrainHalf), Vec2(kTerrainHalf),
                                              terrain_height, 0));
 

@@ -4,6 +4,7 @@
 // alpha mask and a normal map. Loaders map their formats onto this; `at_surface`
 // (core/render/surface_material.hpp) resolves the textures at a surface point.
 #include <string>
+#include <utility>
 #include "core/texture/texture.hpp"
 #include "core/util/math.hpp"
 
@@ -43,6 +44,15 @@ struct Material : SurfaceMaterial {
         return albedo_texture || emission_texture || normal_texture || (alpha_tested() && alpha_texture);
     }
 };
+
+// A named Lambertian material, optionally emissive: the procedural scenes' building block.
+inline Material diffuse_material(std::string name, Vec3 albedo, Vec3 emission = Vec3(0)) {
+    Material m;
+    m.name = std::move(name);
+    m.albedo = albedo;
+    m.emission = emission;
+    return m;
+}
 
 // Roughness α (GGX-style, glTF metallicRoughness) to a Phong exponent with a similar
 // lobe width: n = 2/α² − 2 (Walter et al. 2007).

@@ -21,10 +21,6 @@ std::string format_vec(const Vec3& v) {
     return text;
 }
 
-std::string mesh_label(const Mesh& mesh) {
-    return mesh.name.empty() ? std::string("mesh") : "mesh '" + mesh.name + "'";
-}
-
 // A triangle is dropped when two corners share an index, or when its area vanishes
 // relative to its longest edge (collinear or coincident corners): such triangles have
 // no geometric normal and only produce NaNs in shading.
@@ -42,6 +38,10 @@ bool is_degenerate(const Mesh& mesh, const UVec3& t) {
 }
 
 }  // namespace
+
+std::string mesh_label(const Mesh& mesh) {
+    return mesh.name.empty() ? std::string("mesh") : "mesh '" + mesh.name + "'";
+}
 
 MeshCleanupReport validate_and_clean(Mesh& mesh, size_t material_count, const std::string& source) {
     const std::string label = mesh_label(mesh);

@@ -34,6 +34,9 @@ struct MeshCleanupReport {
 // Checks a freshly loaded mesh: NaN/Inf positions, coordinates beyond kMaxCoordinate and
 // out-of-range indices are errors (thrown, naming `source`); zero-area triangles are
 // dropped and counted.
+// "mesh 'name'" (or "mesh" when unnamed), for error messages.
+std::string mesh_label(const Mesh& mesh);
+
 MeshCleanupReport validate_and_clean(Mesh& mesh, size_t material_count, const std::string& source);
 
 }  // namespace gilab

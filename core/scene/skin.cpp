@@ -9,7 +9,6 @@ namespace {
 
 std::string skin_label(const Skin& skin) { return skin.name.empty() ? std::string("skin") : "skin '" + skin.name + "'"; }
 
-std::string mesh_label(const Mesh& mesh) { return mesh.name.empty() ? std::string("mesh") : "mesh '" + mesh.name + "'"; }
 
 }  // namespace
 
