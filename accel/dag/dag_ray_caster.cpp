@@ -1,24 +1,21 @@
 #include "accel/dag/dag_ray_caster.hpp"
 
-#include <algorithm>
-#include <bit>
-#include <cmath>
 #include "accel/dag/child_mask.hpp"
+#include "accel/dag/dag_ray_walk.hpp"
 #include "accel/dag/svdag.hpp"
 
 namespace gilab {
 namespace {
 
-// Positions live in [1,2), where a float's mantissa bit k stands for a cell of size
-// 2^(k − 23): scale k is the level whose cells have that size.
-constexpr int kMaxScale = 23;
-
-inline uint32_t bits_of(float f) { return std::bit_cast<uint32_t>(f); }
-inline float float_of(uint32_t b) { return std::bit_cast<float>(b); }
-
-struct StackEntry {
-    uint32_t parent;
-    float t_max;
+// P2's words: a node's first word holds its mask, its children's addresses follow.
+struct WordNodes {
+    const uint32_t* words;
+    uint32_t root_address;
+    DagWalkNode root() const { return {root_address, 0}; }
+    uint32_t mask(DagWalkNode node, bool) const { return words[node.address] & 0xffu; }
+    DagWalkNode child(DagWalkNode node, uint32_t mask, uint32_t slot) const {
+        return {words[node.address + 1 + child_rank(mask, int(slot))], 0};
+    }
 };
 
 }  // namespace
@@ -34,121 +31,8 @@ DagWordsView dag_view(const Svdag& dag) {
 }
 
 VoxelRayHit cast_dag_ray(const DagWordsView& dag, const Ray& ray) {
-    VoxelRayHit out;
-    if (dag.empty) return out;
-    // The octree's cube (2^depth voxels per axis) mapped to [1,2]³. The map is affine,
-    // so ray parameters are unchanged; it is done in double so that large scenes keep
-    // their precision up to the final rounding.
-    const double cube = dag.grid.voxel_size() * std::ldexp(1.0, dag.depth);
-    const double inv_cube = 1.0 / cube;
-    const DVec3 origin = 1.0 + (DVec3(ray.origin) - DVec3(dag.grid.origin)) * inv_cube;
-    const DVec3 direction = DVec3(ray.direction) * inv_cube;
-    const float min_component = std::ldexp(1.0f, -kMaxScale);
-
-    // t on axis k at coordinate x is x·coef[k] − bias[k]. Axes with a positive direction
-    // are mirrored (x → 3 − x), so the walk always runs towards −x, −y, −z; `mirror`
-    // turns a mirrored child index back into the node's slot.
-    float coef[3], bias[3];
-    uint32_t mirror = 0;
-    for (int k = 0; k < 3; ++k) {
-        float d = float(direction[k]);
-        if (std::abs(d) < min_component) d = std::copysign(min_component, d);
-        coef[k] = 1.0f / -std::abs(d);
-        bias[k] = coef[k] * float(origin[k]);
-        if (d > 0) {
-            mirror |= 1u << k;
-            bias[k] = 3.0f * coef[k] - bias[k];
-        }
-    }
-    float t_min = std::max({2 * coef[0] - bias[0], 2 * coef[1] - bias[1], 2 * coef[2] - bias[2]});
-    float t_max = std::min({coef[0] - bias[0], coef[1] - bias[1], coef[2] - bias[2]});
-    t_min = std::max(t_min, ray.tmin);
-    t_max = std::min(t_max, ray.tmax);
-    if (!(t_min <= t_max)) return out;
-    out.nodes_visited = 1;  // the root
-    if (dag.depth == 0) {   // a single voxel: the root itself
-        out.hit = true;
-        out.voxel = UVec3(0);
-        out.t = t_min;
-        return out;
-    }
-
-    const uint32_t* words = dag.words.data();
-    const int voxel_scale = kMaxScale - dag.depth;
-    StackEntry stack[kMaxScale + 1];
-    uint32_t parent = dag.root;
-    uint32_t mask = words[parent] & 0xffu;
-    int scale = kMaxScale - 1;
-    float scale_exp2 = 0.5f;  // side of a child at `scale`
-    float pos[3] = {1.0f, 1.0f, 1.0f};  // minimum corner of the current child, mirrored
-    uint32_t idx = 0;                   // the current child, mirrored
-    for (int k = 0; k < 3; ++k)
-        if (1.5f * coef[k] - bias[k] > t_min) idx ^= 1u << k, pos[k] = 1.5f;
-
-    while (scale < kMaxScale) {
-        const float tc[3] = {pos[0] * coef[0] - bias[0], pos[1] * coef[1] - bias[1], pos[2] * coef[2] - bias[2]};
-        const float tc_max = std::min({tc[0], tc[1], tc[2]});  // where the ray leaves the child
-        const uint32_t slot = idx ^ mirror;
-        if ((mask >> slot) & 1u) {
-            const float tv_max = std::min(t_max, tc_max);
-            if (t_min <= tv_max) {
-                ++out.nodes_visited;
-                if (scale == voxel_scale) {
-                    float first[3];
-                    for (int k = 0; k < 3; ++k)
-                        first[k] = (mirror >> k) & 1u ? 3.0f - scale_exp2 - pos[k] : pos[k];
-                    out.hit = true;
-                    out.t = t_min;
-                    out.voxel = UVec3(uint32_t(std::ldexp(first[0] - 1.0f, dag.depth)),
-                                      uint32_t(std::ldexp(first[1] - 1.0f, dag.depth)),
-                                      uint32_t(std::ldexp(first[2] - 1.0f, dag.depth)));
-                    return out;
-                }
-                // Push: descend into the child, remembering where to resume.
-                stack[scale] = {parent, t_max};
-                parent = words[parent + 1 + child_rank(mask, int(slot))];
-                mask = words[parent] & 0xffu;
-                const float half = scale_exp2 * 0.5f;
-                --scale;
-                scale_exp2 = half;
-                // Branch-free: the half the ray enters on each axis (these branches would
-                // be mispredicted about half the time).
-                const uint32_t upper[3] = {half * coef[0] + tc[0] > t_min, half * coef[1] + tc[1] > t_min,
-                                           half * coef[2] + tc[2] > t_min};
-                idx = upper[0] | upper[1] << 1 | upper[2] << 2;
-                for (int k = 0; k < 3; ++k) pos[k] += upper[k] ? half : 0.0f;
-                t_max = tv_max;
-                continue;
-            }
-        }
-        // Advance to the neighbour the ray enters next.
-        const uint32_t crossed[3] = {tc[0] <= tc_max, tc[1] <= tc_max, tc[2] <= tc_max};
-        const uint32_t step = crossed[0] | crossed[1] << 1 | crossed[2] << 2;
-        for (int k = 0; k < 3; ++k) pos[k] -= crossed[k] ? scale_exp2 : 0.0f;
-        t_min = tc_max;
-        idx ^= step;
-        if (t_min > ray.tmax) break;
-        if (idx & step) {
-            // Pop: the step left the parent. The highest bit in which the old and new
-            // positions differ names the level of the common ancestor.
-            uint32_t differing = 0;
-            for (int k = 0; k < 3; ++k)
-                differing |= (bits_of(pos[k]) ^ bits_of(pos[k] + scale_exp2)) & (0u - crossed[k]);
-            scale = int(bits_of(float(differing)) >> 23) - 127;
-            if (scale >= kMaxScale) break;  // left the root
-            scale_exp2 = float_of(uint32_t(scale - kMaxScale + 127) << 23);
-            parent = stack[scale].parent;
-            t_max = stack[scale].t_max;
-            mask = words[parent] & 0xffu;
-            idx = 0;
-            for (int k = 0; k < 3; ++k) {
-                const uint32_t shifted = bits_of(pos[k]) >> scale;
-                pos[k] = float_of(shifted << scale);
-                idx |= (shifted & 1u) << k;
-            }
-        }
-    }
-    return out;
+    if (dag.empty) return {};
+    return walk_dag_ray(WordNodes{dag.words.data(), dag.root}, dag.grid, dag.depth, ray);
 }
 
 }  // namespace gilab

@@ -1,10 +1,7 @@
 #pragma once
 // Fast first-hit ray casting through a DAG in P2's 32-bit word format (Svdag, one frame
-// of a LaidOutMultiFrameDag): the octree walk of Laine & Karras 2010 (ESVO, appendix), in
-// single precision in the [1,2]³ cube with the ray mirrored so that it runs towards −x,
-// −y, −z. Children are entered front to back with no sorting, a step to a neighbour is
-// one comparison per axis, and a pop finds the ancestor to resume from the highest
-// differing bit of the position, so no per-child box test is made.
+// of a LaidOutMultiFrameDag): the octree walk of Laine & Karras 2010 (dag_ray_walk.hpp),
+// so no per-child box test is made.
 //
 // It answers the same question as trace_voxel_ray (accel/dag/voxel_ray_traversal.hpp), the
 // double-precision reference it is tested against: the nearest occupied voxel, where the

@@ -1,0 +1,383 @@
+#include "accel/dag/ssvdag.hpp"
+#include <algorithm>
+#include <string>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include "accel/dag/child_mask.hpp"
+#include "accel/dag/dag_level_table.hpp"
+#include "core/util/error.hpp"
+#include "core/util/morton.hpp"
+
+namespace gilab {
+namespace {
+
+// Of the mirrors x ^ r, r a reflection that leaves the node unchanged (bit r of
+// `symmetries`), the smallest: every view of a symmetric subtree then has one name, which
+// makes keys, and so merging, independent of how the subtree was reached.
+constexpr std::array<std::array<uint8_t, 8>, 256> make_reduced_mirrors() {
+    std::array<std::array<uint8_t, 8>, 256> t{};
+    for (uint32_t symmetries = 0; symmetries < 256; ++symmetries)
+        for (uint32_t x = 0; x < 8; ++x) {
+            uint32_t best = x;
+            for (uint32_t r = 0; r < 8; ++r)
+                if (symmetries & (1u << r)) best = std::min(best, x ^ r);
+            t[symmetries][x] = uint8_t(best);
+        }
+    return t;
+}
+constexpr auto kReducedMirrors = make_reduced_mirrors();
+
+// A child while building: its id on its level and its mirror, id << 3 | mirror, so
+// comparing refs compares (id, mirror).
+inline uint32_t child_ref(uint32_t id, uint32_t mirror) { return id << 3 | mirror; }
+inline uint32_t ref_id(uint32_t ref) { return ref >> 3; }
+inline uint32_t ref_mirror(uint32_t ref) { return ref & 7u; }
+
+// A node in canonical form: the smallest of its 8 reflected keys.
+struct CanonicalNode {
+    uint8_t mask = 0;        // of the stored node
+    uint8_t mirror = 0;      // the smallest reflection turning the stored node into the given one
+    uint8_t symmetries = 0;  // bit r: reflecting the stored node by r leaves it unchanged
+    uint8_t count = 0;
+    uint32_t children[8] = {};  // refs of the stored node's children, in slot order
+    uint64_t hash = 0;
+};
+
+// Key order: the mask, then the child refs in slot order (equal masks, equal counts).
+inline int compare_keys(uint8_t mask_a, const uint32_t* a, uint8_t mask_b, const uint32_t* b, uint32_t count) {
+    if (mask_a != mask_b) return mask_a < mask_b ? -1 : 1;
+    for (uint32_t i = 0; i < count; ++i)
+        if (a[i] != b[i]) return a[i] < b[i] ? -1 : 1;
+    return 0;
+}
+
+// `slot_refs[k]` is the ref of the child in slot k of the node as given;
+// `child_symmetries` the symmetries of the level below, by id. Nodes of level depth-1
+// have no children to key (their children are voxels, alike under every reflection).
+void canonicalize(uint8_t mask, const uint32_t* slot_refs, const uint8_t* child_symmetries, bool has_children,
+                  CanonicalNode& out) {
+    const uint32_t count = has_children ? child_count(mask) : 0;
+    uint32_t key[8];
+    uint32_t ties = 0;  // bit m: reflection m gives the best key
+    for (uint32_t m = 0; m < 8; ++m) {
+        const uint8_t reflected = reflect_mask(mask, m);
+        uint32_t n = 0;
+        if (has_children)
+            for (uint32_t j = 0; j < 8; ++j) {
+                if (!(reflected & (1u << j))) continue;
+                const uint32_t r = slot_refs[j ^ m];
+                key[n++] = child_ref(ref_id(r), kReducedMirrors[child_symmetries[ref_id(r)]][ref_mirror(r) ^ m]);
+            }
+        const int order = m == 0 ? -1 : compare_keys(reflected, key, out.mask, out.children, count);
+        if (order < 0) {
+            out.mask = reflected;
+            std::copy(key, key + n, out.children);
+            out.mirror = uint8_t(m);
+            ties = 1u << m;
+        } else if (order == 0) {
+            ties |= 1u << m;
+        }
+    }
+    // Reflections are their own inverses, so the given node is the stored one reflected by
+    // out.mirror, and the stored one is unchanged exactly by m ^ out.mirror for tied m.
+    out.symmetries = 0;
+    for (uint32_t m = 0; m < 8; ++m)
+        if (ties & (1u << m)) out.symmetries |= uint8_t(1u << (m ^ out.mirror));
+    out.count = uint8_t(count);
+    out.hash = DagLevelTable::hash(out.mask, out.children, count);
+}
+
+// One SVDAG level converted: the ref of each of its nodes (by word address from the
+// level's first word) and the symmetries of each stored node (by id).
+struct ConvertedLevel {
+    uint32_t first_word = 0;
+    std::vector<uint32_t> ref_at;
+    std::vector<uint8_t> symmetries;
+
+    uint32_t ref(uint32_t svdag_address) const { return ref_at[svdag_address - first_word]; }
+};
+
+ConvertedLevel level_frame(const Svdag& dag, const std::vector<uint32_t>& nodes) {
+    ConvertedLevel c;
+    if (nodes.empty()) return c;
+    c.first_word = nodes.front();
+    c.ref_at.assign(nodes.back() + 1 + child_count(dag.mask(nodes.back())) - c.first_word, 0);
+    return c;
+}
+
+}  // namespace
+
+uint32_t encode_ssvdag_pointer(uint64_t address, uint32_t mirror) {
+    if (address >= kSsvdagAddressLimit)
+        throw Error("SSVDAG", "address " + std::to_string(address) + " does not fit in the 29 bits of a pointer");
+    if (mirror > 7) throw Error("SSVDAG", "mirror " + std::to_string(mirror) + " does not fit in 3 bits");
+    return mirror << kSsvdagMirrorShift | uint32_t(address);
+}
+
+// The level-by-level conversion and the layout into words.
+class SsvdagBuilder {
+public:
+    explicit SsvdagBuilder(const Svdag& dag) : dag_(dag), depth_(dag.depth()) {}
+
+    Ssvdag build() {
+        Stopwatch clock;
+        Ssvdag out;
+        out.grid_ = dag_.grid();
+        out.depth_ = depth_;
+        out.level_counts_.assign(depth_ + 1, 0);
+        if (!dag_.empty()) {
+            out.empty_ = false;
+            out.level_counts_[depth_] = 1;
+            if (depth_ > 0) {
+                tables_.resize(depth_ - 1);
+                ConvertedLevel below = convert_leaf_parents();
+                for (int l = depth_ - 2; l >= 0; --l) below = convert_level(l, below);
+                const uint32_t root_ref = below.ref(dag_.root());
+                out.stats_.table_bytes = table_bytes();
+                lay_out(out, root_ref);
+            }
+        }
+        out.stats_.input_nodes = dag_.node_count();
+        out.stats_.dedup_ms = dedup_ms_;
+        out.stats_.total_ms = clock.elapsed_ms();
+        return out;
+    }
+
+private:
+    // Level depth-1: a node is its mask alone, so at most 46 masks survive the reflections.
+    ConvertedLevel convert_leaf_parents() {
+        Stopwatch t;
+        const std::vector<uint32_t> nodes = dag_.level_nodes(depth_ - 1);
+        ConvertedLevel c = level_frame(dag_, nodes);
+        std::array<uint32_t, 256> id_of;
+        id_of.fill(kInvalidNode);
+        for (uint32_t a : nodes) {
+            CanonicalNode n;
+            canonicalize(dag_.mask(a), nullptr, nullptr, false, n);
+            uint32_t& id = id_of[n.mask];
+            if (id == kInvalidNode) {
+                id = uint32_t(leaf_masks_.size());
+                leaf_masks_.push_back(n.mask);
+                c.symmetries.push_back(n.symmetries);
+            }
+            c.ref_at[a - c.first_word] = child_ref(id, n.mirror);
+        }
+        dedup_ms_ += t.elapsed_ms();
+        return c;
+    }
+
+    ConvertedLevel convert_level(int level, const ConvertedLevel& below) {
+        Stopwatch t;
+        const std::vector<uint32_t> nodes = dag_.level_nodes(level);
+        ConvertedLevel c = level_frame(dag_, nodes);
+        const std::span<const uint32_t> words = dag_.words();
+        DagLevelTable& table = tables_[level];
+        // Keys are made in parallel a chunk at a time (bounded memory), then looked up in
+        // order so that ids, and so the words, do not depend on the thread count.
+        constexpr size_t kChunk = size_t(1) << 16;
+        std::vector<CanonicalNode> keyed(std::min(nodes.size(), kChunk));
+        for (size_t begin = 0; begin < nodes.size(); begin += kChunk) {
+            const size_t end = std::min(nodes.size(), begin + kChunk);
+            tbb::parallel_for(tbb::blocked_range<size_t>(begin, end, 1024), [&](const tbb::blocked_range<size_t>& r) {
+                for (size_t j = r.begin(); j < r.end(); ++j) {
+                    const uint32_t a = nodes[j];
+                    const uint32_t mask = words[a] & 0xffu;
+                    uint32_t slot_refs[8];
+                    for (uint32_t s = 0, i = 0; s < 8; ++s)
+                        if (mask & (1u << s)) slot_refs[s] = below.ref(words[a + 1 + i++]);
+                    canonicalize(uint8_t(mask), slot_refs, below.symmetries.data(), true, keyed[j - begin]);
+                }
+            });
+            constexpr size_t kAhead = 16;  // prefetch distance: lookups miss the cache
+            for (size_t j = begin; j < end; ++j) {
+                if (j + kAhead < end) table.prefetch(keyed[j + kAhead - begin].hash);
+                const CanonicalNode& n = keyed[j - begin];
+                const size_t before = table.size();
+                const uint32_t id = table.find_or_insert(n.mask, n.children, n.count, n.hash);
+                if (table.size() != before) {
+                    if (id >= kSsvdagAddressLimit)
+                        throw Error("SSVDAG", "level " + std::to_string(level) + " holds more than 2^29 nodes");
+                    c.symmetries.push_back(n.symmetries);
+                }
+                c.ref_at[nodes[j] - c.first_word] = child_ref(id, n.mirror);
+            }
+        }
+        dedup_ms_ += t.elapsed_ms();
+        return c;
+    }
+
+    size_t table_bytes() const {
+        size_t b = leaf_masks_.capacity();
+        for (const auto& t : tables_) b += t.memory_bytes();
+        return b;
+    }
+
+    // Interior levels top-down, then the leaf masks; pointers turn ids into addresses.
+    void lay_out(Ssvdag& out, uint32_t root_ref) {
+        const int interior = depth_ - 1;  // levels stored as header + pointers
+        std::vector<std::vector<uint32_t>> address(interior);
+        out.level_begin_.assign(size_t(interior) + 1, 0);
+        uint64_t next = 0;
+        for (int l = 0; l < interior; ++l) {
+            const DagLevelTable& t = tables_[l];
+            out.level_begin_[l] = next;
+            out.level_counts_[l] = t.size();
+            address[l].resize(t.size());
+            for (uint32_t u = 0; u < t.size(); ++u) {
+                address[l][u] = uint32_t(std::min<uint64_t>(next, kSsvdagAddressLimit));
+                next += 1 + t.children(u).size();
+            }
+            out.pointer_count_ += t.child_count_total();
+        }
+        out.level_begin_[interior] = next;
+        out.level_counts_[depth_ - 1] = leaf_masks_.size();
+        // Every interior address must fit a pointer; checked before allocating the words.
+        if (next > kSsvdagAddressLimit)
+            throw Error("SSVDAG", "the DAG needs " + std::to_string(next) +
+                                      " words of nodes, more than the 2^29 that 29-bit pointers address");
+        const uint64_t leaf_words = (leaf_masks_.size() + 3) / 4;
+        out.leaf_begin_ = uint32_t(next);
+        out.words_.assign(next + leaf_words, 0);
+        for (size_t i = 0; i < leaf_masks_.size(); ++i)
+            out.words_[next + i / 4] |= uint32_t(leaf_masks_[i]) << (8 * (i % 4));
+
+        for (int l = 0; l < interior; ++l) {
+            const DagLevelTable& t = tables_[l];
+            // Below the last interior level a child is a leaf mask, named by its index.
+            const std::vector<uint32_t>* below = l + 1 < interior ? &address[l + 1] : nullptr;
+            tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(t.size()), 4096),
+                              [&](const tbb::blocked_range<uint32_t>& r) {
+                                  for (uint32_t u = r.begin(); u < r.end(); ++u) {
+                                      const uint32_t a = address[l][u];
+                                      out.words_[a] = t.header(u);
+                                      const auto kids = t.children(u);
+                                      for (size_t k = 0; k < kids.size(); ++k) {
+                                          const uint32_t id = ref_id(kids[k]);
+                                          out.words_[a + 1 + k] = ref_mirror(kids[k]) << kSsvdagMirrorShift |
+                                                                  (below ? (*below)[id] : id);
+                                      }
+                                  }
+                              });
+            for (uint32_t u = 0; u < t.size(); ++u)
+                for (uint32_t ref : t.children(u)) out.mirrored_pointer_count_ += ref_mirror(ref) != 0;
+            std::vector<uint32_t>().swap(address[l]);
+        }
+        out.root_ = {0, ref_mirror(root_ref)};
+    }
+
+    const Svdag& dag_;
+    int depth_;
+    std::vector<DagLevelTable> tables_;  // levels 0..depth-2
+    std::vector<uint8_t> leaf_masks_;    // level depth-1, by id
+    double dedup_ms_ = 0;
+};
+
+Ssvdag Ssvdag::from_svdag(const Svdag& dag) { return SsvdagBuilder(dag).build(); }
+
+std::optional<SsvdagPointer> Ssvdag::child(const SsvdagPointer& node, int level, int slot) const {
+    const uint32_t stored_slot = uint32_t(slot) ^ node.mirror;
+    const uint32_t m = stored_mask(node.address, level);
+    if (!(m & (1u << stored_slot))) return std::nullopt;
+    if (level == depth_ - 1) return SsvdagPointer{0, node.mirror};  // a voxel: not stored
+    SsvdagPointer c = decode_ssvdag_pointer(words_[node.address + 1 + child_rank(m, int(stored_slot))]);
+    c.mirror ^= node.mirror;
+    return c;
+}
+
+std::vector<uint32_t> Ssvdag::level_nodes(int level) const {
+    std::vector<uint32_t> nodes;
+    if (empty_ || level < 0 || level >= depth_) return nodes;
+    if (level == depth_ - 1) {
+        for (uint32_t i = 0; i < level_counts_[level]; ++i) nodes.push_back(i);
+        return nodes;
+    }
+    for (uint64_t a = level_begin_[level]; a < level_begin_[level + 1]; a += 1 + child_count(words_[a]))
+        nodes.push_back(uint32_t(a));
+    return nodes;
+}
+
+size_t Ssvdag::node_count() const {
+    size_t n = 0;
+    for (uint64_t c : level_counts_) n += c;
+    return n;
+}
+
+uint64_t Ssvdag::voxel_count() const {
+    if (empty_) return 0;
+    if (depth_ == 0) return 1;
+    // Voxels below each stored node, from the leaf masks up; reflections keep the count.
+    std::vector<uint64_t> leaf_voxels(level_counts_[depth_ - 1]);
+    for (uint32_t i = 0; i < leaf_voxels.size(); ++i) leaf_voxels[i] = child_count(leaf_mask(i));
+    if (depth_ == 1) return leaf_voxels[root_.address];
+    std::vector<uint64_t> below(leaf_begin_, 0);
+    for (int l = depth_ - 2; l >= 0; --l) {
+        const std::vector<uint64_t>& source = l == depth_ - 2 ? leaf_voxels : below;
+        for (uint32_t a : level_nodes(l)) {
+            const uint32_t k = child_count(words_[a]);
+            uint64_t sum = 0;
+            for (uint32_t i = 0; i < k; ++i) sum += source[decode_ssvdag_pointer(words_[a + 1 + i]).address];
+            below[a] = sum;
+        }
+    }
+    return below[root_.address];
+}
+
+bool Ssvdag::contains_voxel(const UVec3& v) const {
+    if (empty_ || v.x >= grid_.resolution || v.y >= grid_.resolution || v.z >= grid_.resolution) return false;
+    SsvdagPointer node = root_;
+    for (int l = 0; l < depth_; ++l) {
+        const int shift = depth_ - 1 - l;
+        const auto c = child(node, l, octree_child_slot(v.x >> shift, v.y >> shift, v.z >> shift));
+        if (!c) return false;
+        node = *c;
+    }
+    return true;
+}
+
+bool Ssvdag::occupied(const Vec3& p) const {
+    const auto v = grid_.voxel_of(p);
+    return v && contains_voxel(*v);
+}
+
+std::vector<uint64_t> Ssvdag::decode() const {
+    std::vector<uint64_t> codes;
+    if (empty_) return codes;
+    if (depth_ == 0) return {0};
+    struct Item {
+        SsvdagPointer node;
+        int level;
+        uint64_t code;
+    };
+    std::vector<Item> stack{{root_, 0, 0}};
+    while (!stack.empty()) {
+        const Item it = stack.back();
+        stack.pop_back();
+        if (it.level == depth_ - 1) {
+            const uint8_t m = mask(it.node, it.level);
+            for (uint32_t s = 0; s < 8; ++s)
+                if (m & (1u << s)) codes.push_back(it.code << 3 | s);
+            continue;
+        }
+        for (int s = 7; s >= 0; --s)  // reversed so slot 0 pops first: Morton order
+            if (const auto c = child(it.node, it.level, s))
+                stack.push_back({*c, it.level + 1, it.code << 3 | uint64_t(s)});
+    }
+    return codes;
+}
+
+Stats Ssvdag::stats() const {
+    Stats s;
+    s.set("nodes", double(node_count()));
+    s.set("pointers", double(pointer_count()));
+    s.set("mirrored_pointers", double(mirrored_pointer_count()));
+    s.set("bytes", double(bytes()));
+    s.set("convert_ms", stats_.total_ms);
+    s.set("dedup_ms", stats_.dedup_ms);
+    s.set("input_nodes", double(stats_.input_nodes));
+    s.set("table_bytes", double(stats_.table_bytes));
+    for (size_t l = 0; l < level_counts_.size(); ++l)
+        s.set("nodes_level_" + std::to_string(l), double(level_counts_[l]));
+    return s;
+}
+
+}  // namespace gilab
