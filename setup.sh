@@ -46,9 +46,10 @@ case "$mode" in
     ;;
   test)
     ctest --test-dir build --output-on-failure --no-tests=error -j "$jobs"
-    # The suite again, built with AddressSanitizer and UBSan at -O1 (a finding fails its
-    # test), without the tests labelled heavy (the whole experiments at quick size and the
-    # every-shipped-scene renders, which the sanitizers slow about tenfold), slurm and
+    # The suite again, with gilab's libraries built with AddressSanitizer and UBSan at -O1
+    # (a finding fails its test; the tests' own code is built plain), without the tests
+    # labelled heavy (the whole experiments at quick size and the every-shipped-scene
+    # renders, which the sanitizers slow about tenfold), slurm and
     # browser (they start the Slurm daemons and Chromium, which no sanitizer build changes;
     # the sweep and report code they drive runs sanitized in the sweep and report tests).
     cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O1 -DNDEBUG" \
