@@ -2,6 +2,7 @@
 #include "accel/dag/child_mask.hpp"
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 #include "accel/dag/dag_level_table.hpp"
 #include "accel/dag/svdag_merger.hpp"
 #include "core/util/error.hpp"
@@ -229,12 +230,27 @@ Svdag Svdag::from_voxelizer(const Voxelizer& voxelizer, int split_level) {
     const VoxelGrid& grid = voxelizer.grid();
     checked_split_level(grid, split_level);
     const int cell_log2 = grid.depth() - split_level;
-    std::vector<uint64_t> cells = voxelizer.touched_cells(cell_log2);
-    return from_slices(grid, split_level, cells, [&](uint64_t cell) {
-        VoxelRegion region;
-        region.begin = morton_decode(cell) << UVec3(uint32_t(cell_log2));
-        region.end = region.begin + UVec3(1u << cell_log2);
-        return std::move(voxelizer.voxelize(region).codes);
+    // Each cell voxelizes only its own triangles, so the build's time grows with the
+    // voxels, not with cells × the scene's triangles.
+    // A batch of cells, one per thread, is voxelized in parallel (a small cell's
+    // voxelization is mostly serial); the merge takes them in order.
+    const CellTriangles bins = voxelizer.bin_triangles(cell_log2);
+    const size_t batch_cells = size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
+    std::vector<std::vector<uint64_t>> batch;
+    size_t batch_begin = 0, next = 0;  // from_slices asks for the cells in ascending order
+    return from_slices(grid, split_level, bins.cells, [&](uint64_t cell) {
+        while (bins.cells[next] != cell) ++next;
+        if (next < batch_begin || next >= batch_begin + batch.size()) {
+            batch_begin = next;
+            batch.assign(std::min(batch_cells, bins.cells.size() - next), {});
+            tbb::parallel_for(size_t(0), batch.size(), [&](size_t i) {
+                VoxelRegion region;
+                region.begin = morton_decode(bins.cells[batch_begin + i]) << UVec3(uint32_t(cell_log2));
+                region.end = region.begin + UVec3(1u << cell_log2);
+                batch[i] = std::move(voxelizer.voxelize(region, bins.of(batch_begin + i)).codes);
+            });
+        }
+        return std::move(batch[next - batch_begin]);
     });
 }
 

@@ -11,7 +11,8 @@
 // A split build converts the subtrees below a chosen level one at a time (each from its
 // own contiguous slice of the Morton-sorted voxels, or voxelized on demand), joins
 // their roots and merges the levels above, so the peak memory is the finished DAG plus
-// one subtree. The minimal DAG is unique, so every split level gives the same DAG.
+// one subtree (one per thread when they are voxelized on demand).
+// The minimal DAG is unique, so every split level gives the same DAG.
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -63,8 +64,9 @@ public:
     using SliceSource = std::function<std::vector<uint64_t>(uint64_t cell)>;
     static Svdag from_slices(const VoxelGrid& grid, int split_level, std::span<const uint64_t> cells,
                              const SliceSource& slice);
-    // Split build that voxelizes one level-`split_level` cell at a time, so a grid far
-    // too large to hold as a voxel list still converts.
+    // Split build that voxelizes the level-`split_level` cells a batch at a time (one per
+    // thread, in parallel), each from only the triangles binned into it, so a grid far too large to
+    // hold as a voxel list still converts, in time that grows with its voxels.
     static Svdag from_voxelizer(const Voxelizer& voxelizer, int split_level);
 
     const VoxelGrid& grid() const { return grid_; }

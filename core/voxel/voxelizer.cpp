@@ -240,8 +240,9 @@ struct Voxelizer::Impl {
     void add_masks(std::span<const Vec3> positions, std::span<const UVec3> tris, std::span<const TriangleMask> input);
 
     void init(std::span<const Vec3> positions, std::span<const UVec3> tris);
-    VoxelList run(VoxelRegion region) const;
-    uint64_t estimate_in(const VoxelRegion& region) const;
+    // `subset`: indices of the triangles to voxelize (all when absent).
+    VoxelList run(VoxelRegion region, const std::span<const uint32_t>* subset = nullptr) const;
+    uint64_t estimate_in(const VoxelRegion& region, const std::span<const uint32_t>* subset = nullptr) const;
 };
 
 void Voxelizer::Impl::init(std::span<const Vec3> positions, std::span<const UVec3> tris) {
@@ -273,12 +274,13 @@ void Voxelizer::Impl::init(std::span<const Vec3> positions, std::span<const UVec
     });
 }
 
-uint64_t Voxelizer::Impl::estimate_in(const VoxelRegion& region) const {
+uint64_t Voxelizer::Impl::estimate_in(const VoxelRegion& region, const std::span<const uint32_t>* subset) const {
     if (region.empty()) return 0;
     double total = tbb::parallel_reduce(
-        tbb::blocked_range<size_t>(0, triangles.size(), 4096), 0.0,
+        tbb::blocked_range<size_t>(0, subset ? subset->size() : triangles.size(), 4096), 0.0,
         [&](const tbb::blocked_range<size_t>& r, double sum) {
-            for (size_t i = r.begin(); i < r.end(); ++i) {
+            for (size_t j = r.begin(); j < r.end(); ++j) {
+                const size_t i = subset ? (*subset)[j] : j;
                 const PreparedTriangle& t = triangles[i];
                 double cells = 1;
                 for (int k = 0; k < 3; ++k) {
@@ -294,14 +296,14 @@ uint64_t Voxelizer::Impl::estimate_in(const VoxelRegion& region) const {
     return static_cast<uint64_t>(std::min(total, double(region.volume())));
 }
 
-VoxelList Voxelizer::Impl::run(VoxelRegion region) const {
+VoxelList Voxelizer::Impl::run(VoxelRegion region, const std::span<const uint32_t>* subset) const {
     Stopwatch clock;
     VoxelList out;
     out.grid = grid;
     region = region.intersect(grid.full_region());
     if (region.empty()) return out;
 
-    const uint64_t estimated = estimate_in(region);
+    const uint64_t estimated = estimate_in(region, subset);
     out.stats.estimated_voxels = estimated;
     if (double(estimated) * 8.0 > double(options.max_bytes))
         throw Error("voxelizer", "resolution " + std::to_string(grid.resolution) + " would give about " +
@@ -327,10 +329,12 @@ VoxelList Voxelizer::Impl::run(VoxelRegion region) const {
     };
     tbb::enumerable_thread_specific<std::vector<Pair>> local_pairs;
     std::atomic<uint64_t> tests_total{0}, triangles_used{0};
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    const size_t input_count = subset ? subset->size() : triangles.size();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, input_count, 256), [&](const tbb::blocked_range<size_t>& r) {
         auto& pairs = local_pairs.local();
         uint64_t tests = 0, used = 0;
-        for (size_t i = r.begin(); i < r.end(); ++i) {
+        for (size_t j = r.begin(); j < r.end(); ++j) {
+            const size_t i = subset ? (*subset)[j] : j;
             size_t before = pairs.size();
             rasterize(triangles[i], brick_log2, kCoarsePad, brick_clip, tests, [&](int64_t x, int64_t y, int64_t z) {
                 pairs.push_back({morton_encode(uint32_t(x), uint32_t(y), uint32_t(z)), uint32_t(i)});
@@ -502,6 +506,13 @@ const VoxelizeOptions& Voxelizer::options() const { return impl_->options; }
 size_t Voxelizer::triangle_count() const { return impl_->triangles.size(); }
 VoxelList Voxelizer::voxelize() const { return impl_->run(impl_->grid.full_region()); }
 VoxelList Voxelizer::voxelize(const VoxelRegion& region) const { return impl_->run(region); }
+VoxelList Voxelizer::voxelize(const VoxelRegion& region, std::span<const uint32_t> triangles) const {
+    for (uint32_t t : triangles)
+        if (t >= impl_->triangles.size())
+            throw Error("voxelizer", "triangle " + std::to_string(t) + " does not exist (there are " +
+                                         std::to_string(impl_->triangles.size()) + ")");
+    return impl_->run(region, &triangles);
+}
 uint64_t Voxelizer::estimate_voxels(const VoxelRegion& region) const {
     return impl_->estimate_in(region.intersect(impl_->grid.full_region()));
 }
@@ -530,6 +541,65 @@ std::vector<uint64_t> Voxelizer::touched_cells(int cell_log2) const {
     tbb::parallel_sort(cells.begin(), cells.end());
     cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
     return cells;
+}
+
+CellTriangles Voxelizer::bin_triangles(int cell_log2) const {
+    const VoxelGrid& grid = impl_->grid;
+    cell_log2 = std::clamp(cell_log2, 0, grid.depth());
+    CellBox clip;
+    for (int k = 0; k < 3; ++k) {
+        clip.lo[k] = 0;
+        clip.hi[k] = ((int64_t(grid.resolution) - 1) >> cell_log2) + 1;
+    }
+    const auto& triangles = impl_->triangles;
+    // Counted first, so that a binning too large for the budget fails before it allocates.
+    const uint64_t pair_count = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, triangles.size(), 256), uint64_t(0),
+        [&](const tbb::blocked_range<size_t>& r, uint64_t sum) {
+            uint64_t tests = 0;
+            for (size_t i = r.begin(); i < r.end(); ++i)
+                rasterize(triangles[i], cell_log2, kCoarsePad, clip, tests, [&](int64_t, int64_t, int64_t) { ++sum; });
+            return sum;
+        },
+        std::plus<uint64_t>());
+    struct Pair {
+        uint64_t cell;
+        uint32_t triangle;
+        bool operator<(const Pair& o) const { return cell != o.cell ? cell < o.cell : triangle < o.triangle; }
+    };
+    if (double(pair_count) * 2.0 * sizeof(Pair) > double(impl_->options.max_bytes))
+        throw Error("voxelizer", "binning " + std::to_string(triangles.size()) + " triangles into cells of " +
+                                     std::to_string(uint64_t(1) << cell_log2) + "³ voxels gives " +
+                                     std::to_string(pair_count) + " (cell, triangle) pairs (" +
+                                     gib(double(pair_count) * 2.0 * sizeof(Pair)) + "), more than the memory budget of " +
+                                     gib(double(impl_->options.max_bytes)) + "; use larger cells");
+    tbb::enumerable_thread_specific<std::vector<Pair>> local;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+        auto& pairs = local.local();
+        uint64_t tests = 0;
+        for (size_t i = r.begin(); i < r.end(); ++i)
+            rasterize(triangles[i], cell_log2, kCoarsePad, clip, tests, [&](int64_t x, int64_t y, int64_t z) {
+                pairs.push_back({morton_encode(uint32_t(x), uint32_t(y), uint32_t(z)), uint32_t(i)});
+            });
+    });
+    std::vector<Pair> pairs;
+    pairs.reserve(pair_count);
+    for (auto& p : local) {
+        pairs.insert(pairs.end(), p.begin(), p.end());
+        std::vector<Pair>().swap(p);
+    }
+    tbb::parallel_sort(pairs.begin(), pairs.end());
+    CellTriangles bins;
+    bins.triangles.reserve(pairs.size());
+    for (size_t i = 0; i < pairs.size(); ++i) {
+        if (i == 0 || pairs[i].cell != pairs[i - 1].cell) {
+            bins.cells.push_back(pairs[i].cell);
+            bins.begin.push_back(i);
+        }
+        bins.triangles.push_back(pairs[i].triangle);
+    }
+    bins.begin.push_back(pairs.size());
+    return bins;
 }
 
 VoxelList voxelize(std::span<const Vec3> positions, std::span<const UVec3> triangles, const VoxelGrid& grid,

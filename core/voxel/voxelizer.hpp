@@ -51,6 +51,19 @@ struct VoxelizeStats {
     uint64_t box_tests = 0;          // triangle/voxel tests run
 };
 
+// Triangles binned into the aligned cells of 2^cell_log2 voxels per axis that they may
+// overlap (the cells touched_cells finds for them): cells ascending, and cell i's triangles
+// ascending in triangles[begin[i] .. begin[i + 1]).
+struct CellTriangles {
+    std::vector<uint64_t> cells;     // Morton codes of the cell coordinates
+    std::vector<size_t> begin;       // cells.size() + 1 offsets
+    std::vector<uint32_t> triangles;
+
+    std::span<const uint32_t> of(size_t i) const {
+        return std::span<const uint32_t>(triangles).subspan(begin[i], begin[i + 1] - begin[i]);
+    }
+};
+
 struct VoxelList {
     VoxelGrid grid;
     std::vector<uint64_t> codes;     // Morton codes (core/util/morton.hpp), ascending, unique
@@ -82,6 +95,10 @@ public:
     // Throws Error when the estimate exceeds options().max_bytes.
     VoxelList voxelize() const;
     VoxelList voxelize(const VoxelRegion& region) const;
+    // The voxels of only `triangles` (indices) inside `region`: the same as voxelize(region)
+    // when they include every triangle that meets the region (a bin of bin_triangles over
+    // the region's cell does), in time proportional to their count, not the scene's.
+    VoxelList voxelize(const VoxelRegion& region, std::span<const uint32_t> triangles) const;
 
     // Estimate of the occupied voxels inside a region: projected triangle areas plus
     // edge lengths, in voxels, capped by the region volume. On smooth meshes it is
@@ -90,6 +107,10 @@ public:
     // Aligned cells of 2^cell_log2 voxels per axis that some triangle overlaps, as the
     // Morton codes of the cell coordinates (cell = voxel >> cell_log2), ascending.
     std::vector<uint64_t> touched_cells(int cell_log2) const;
+    // Each triangle binned into the cells touched_cells counts it in (so bins.cells equals
+    // touched_cells). Throws Error before allocating when the (cell, triangle) pairs would
+    // exceed options().max_bytes.
+    CellTriangles bin_triangles(int cell_log2) const;
 
 private:
     struct Impl;

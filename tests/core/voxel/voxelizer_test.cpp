@@ -232,6 +232,53 @@ TEST(Voxelizer, TouchedCellsCoverEveryVoxel) {
     }
 }
 
+// A cell voxelized from its bin alone gives the cell's voxels of the whole scene, and the
+// bins' cells are the touched cells.
+TEST(Voxelizer, BinnedCellsGiveTheWholeScenesVoxels) {
+    std::mt19937 rng(12);
+    TriangleSoup m = gilab::test::random_triangles(rng, 60, Vec3(0), Vec3(1));
+    VoxelGrid g = gilab::test::unit_grid(64);
+    Voxelizer vox(m.positions, m.triangles, g);
+    const VoxelList all = vox.voxelize();
+    for (int log2 : {2, 4, 5}) {
+        const CellTriangles bins = vox.bin_triangles(log2);
+        EXPECT_EQ(bins.cells, vox.touched_cells(log2)) << "cells of " << (1 << log2) << "³";
+        ASSERT_EQ(bins.begin.size(), bins.cells.size() + 1);
+        std::vector<uint64_t> joined;
+        size_t binned_below_all = 0;
+        for (size_t i = 0; i < bins.cells.size(); ++i) {
+            const UVec3 lo = morton_decode(bins.cells[i]) << UVec3(uint32_t(log2));
+            const VoxelRegion r{lo, lo + UVec3(1u << log2)};
+            const auto part = vox.voxelize(r, bins.of(i)).codes;
+            ASSERT_EQ(part, vox.voxelize(r).codes) << "cell " << i << " of " << (1 << log2) << "³";
+            joined.insert(joined.end(), part.begin(), part.end());
+            binned_below_all += bins.of(i).size() < m.triangles.size();
+        }
+        EXPECT_EQ(joined, all.codes);
+        // The bins are what makes a cell cheap: most cells see only some triangles.
+        EXPECT_GT(binned_below_all, bins.cells.size() / 2) << "cells of " << (1 << log2) << "³";
+    }
+    // Only the given triangles are voxelized: one triangle's voxels are its voxelizer's.
+    const uint32_t first[] = {0};
+    const std::vector<UVec3> alone = {m.triangles[0]};
+    EXPECT_EQ(vox.voxelize(g.full_region(), first).codes, Voxelizer(m.positions, alone, g).voxelize().codes);
+    const uint32_t missing[] = {uint32_t(m.triangles.size())};
+    EXPECT_THROW(vox.voxelize(g.full_region(), missing), Error);
+}
+
+TEST(Voxelizer, BinningBeyondTheBudgetIsRefusedBeforeAllocating) {
+    TriangleSoup m = gilab::test::uv_sphere(Vec3(0.5f), 0.45f);
+    VoxelizeOptions small;
+    small.max_bytes = 1024;
+    Voxelizer vox(m.positions, m.triangles, gilab::test::unit_grid(512), small);
+    try {
+        vox.bin_triangles(0);
+        FAIL() << "binning a sphere into single voxels at 512³ fits in 1 KiB";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("memory budget"), std::string::npos) << e.what();
+    }
+}
+
 TEST(Voxelizer, SceneFrameGathersAllMeshes) {
     TriangleSoup a = gilab::test::uv_sphere(Vec3(0.3f), 0.2f), b = gilab::test::uv_sphere(Vec3(0.7f), 0.2f);
     SceneFrame frame;
