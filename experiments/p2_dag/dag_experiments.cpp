@@ -5,7 +5,6 @@
 // the probes below measure it, the reducers lay the rows out as the paper's tables.
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <memory>
 #include <optional>
 #include "accel/dag/esvo.hpp"
@@ -22,6 +21,7 @@
 #include "core/scene/scene.hpp"
 #include "core/util/stats.hpp"
 #include "core/voxel/voxelizer.hpp"
+#include "experiments/p2_dag/dag_models.hpp"
 #include "experiments/runner/experiment.hpp"
 #include "experiments/runner/measures.hpp"
 #include "experiments/runner/paper_figures.hpp"
@@ -33,36 +33,7 @@ namespace gilab {
 namespace {
 
 using nlohmann::json;
-
-// The paper's three models, in its table order; `scene` is the spec's scene name, `node`
-// names the model's entry in the scene file (the floor is another entry and is left out
-// of the voxelization), `paper` its name in the paper's tables.
-struct ModelSpec {
-    std::string label;
-    std::string scene;
-    std::string node;
-    std::string paper;
-};
-
-const std::vector<ModelSpec>& model_specs() {
-    static const std::vector<ModelSpec> specs = {{"Bunny", "bunny", "bunny", "Bunny"},
-                                                 {"Happy Buddha", "buddha", "buddha", "Buddha"},
-                                                 {"Dragon", "dragon", "dragon", "Dragon"}};
-    return specs;
-}
-
-const ModelSpec& model_spec(const std::string& scene) {
-    for (const ModelSpec& m : model_specs())
-        if (m.scene == scene) return m;
-    throw Error("P2 DAG experiments", "no model for scene '" + scene + "' (bunny, buddha or dragon)");
-}
-
-// The spec's scenes: the models in the paper's order.
-std::vector<std::string> model_scenes() {
-    std::vector<std::string> scenes;
-    for (const ModelSpec& m : model_specs()) scenes.push_back(m.scene);
-    return scenes;
-}
+using namespace p2;
 
 // ---- The paper's published figures (experiments/papers/p2; reference data, never used as results) ----
 
@@ -98,132 +69,11 @@ std::optional<PaperTimes> paper_table3(const std::string& paper_scene, uint32_t 
     return PaperTimes{r->number("t_A ms"), r->number("t_B ms")};
 }
 
-// ---- Models ----
-
-struct Model {
-    std::string label, scene, paper;
-    std::vector<Vec3> positions;
-    std::vector<UVec3> triangles;
-    Bounds3 bounds;
-    SceneCamera camera;
-};
-
-// The model's meshes in world space (as placed by its scene file).
-std::shared_ptr<const Model> load_model(const ModelSpec& spec, const AssetPaths& assets) {
-    Scene scene = open_scene(spec.scene, assets).scene;
-    SceneFrame frame = scene.evaluate(0.0);
-    auto model = std::make_shared<Model>();
-    model->label = spec.label;
-    model->scene = spec.scene;
-    model->paper = spec.paper;
-    for (const WorldMesh& mesh : frame.meshes) {
-        bool inside = false;
-        for (int n = int(mesh.node); n >= 0 && !inside; n = scene.nodes[size_t(n)].parent)
-            inside = scene.nodes[size_t(n)].name == spec.node;
-        if (!inside) continue;
-        const uint32_t base = uint32_t(model->positions.size());
-        model->positions.insert(model->positions.end(), mesh.positions.begin(), mesh.positions.end());
-        for (const UVec3& t : mesh.triangles) model->triangles.push_back(t + UVec3(base));
-    }
-    if (model->triangles.empty())
-        throw Error(scene.source, "no mesh under a node named '" + spec.node + "' (the model to voxelize)");
-    for (const Vec3& p : model->positions) model->bounds.extend(p);
-    model->camera = scene.camera.value_or(default_camera_for(model->bounds));
-    return model;
-}
-
-// A model, or why it could not be loaded (a missing asset skips its rows with a note).
-struct ModelLoad {
-    std::shared_ptr<const Model> model;
-    std::string skipped;
-};
-
-// The task's model, loaded once per run and shared by its tasks.
-const ModelLoad& task_model(const ProbeCall& call) {
-    return call.cache.get<ModelLoad>("p2-model:" + call.task.scene, [&] {
-        const ModelSpec& spec = model_spec(call.task.scene);
-        ModelLoad load;
-        try {
-            load.model = load_model(spec, call.ctx.assets);
-            call.ctx.say(spec.label + ": " + std::to_string(load.model->triangles.size()) + " triangles");
-        } catch (const std::exception& e) {
-            load.skipped = spec.label + " (scene '" + spec.scene + "') skipped: " + e.what();
-            call.ctx.say("skipping " + spec.label + ": " + e.what());
-        }
-        return load;
-    });
-}
-
-// A probe over a loaded model: `measure` fills the output; a model that did not load
-// gives no rows and the note saying why.
-template <class Measure>
-ProbeFunction model_probe(Measure measure) {
-    return [measure](const ProbeCall& call) {
-        const ModelLoad& load = task_model(call);
-        ProbeOutput out;
-        if (!load.model) {
-            out.notes.push_back(load.skipped);
-            return out;
-        }
-        measure(call, *load.model, out);
-        return out;
-    };
-}
-
-VoxelGrid model_grid(const Model& model, uint32_t res) { return VoxelGrid::enclosing(model.bounds, res); }
-
-const char* kGridNote =
-    "Grid placement: each model is voxelized alone (its floor left out) as placed by its scene file in scenes/, in the "
-    "smallest cube enclosing its bounding box, centred on the box and grown by 0.1% per side (VoxelGrid::enclosing); "
-    "the longest side of the box spans the N voxels, the octree has depth ceil(log2 N) (1024 cells per axis for "
-    "N = 1000, cells beyond N−1 never occupied). Voxels are conservative surface voxels (triangle/box overlap), not "
-    "solid. The paper does not say how it placed or scaled its models, so absolute counts differ; the ratio columns "
-    "are the comparable figures.";
-
 // ---- Formatting ----
-
-std::string cube(uint32_t n) { return std::to_string(n) + "³"; }
-
-size_t available_memory_bytes() {
-    std::ifstream meminfo("/proc/meminfo");
-    std::string key;
-    size_t kib = 0;
-    while (meminfo >> key) {
-        if (key == "MemAvailable:") {
-            meminfo >> kib;
-            return kib * 1024;
-        }
-        meminfo.ignore(1 << 10, '\n');
-    }
-    return size_t(8) << 30;
-}
 
 // The values of the spec's only axis in this run (quick or full).
 const std::vector<json>& axis_points(const SpecReduction& r) {
     return r.ctx.quick ? r.spec.axes.at(0).quick : r.spec.axes.at(0).full;
-}
-
-// `row` with exactly `columns`, in that order (null where it has none).
-json project(const json& row, const std::vector<std::string>& columns) {
-    json out = json::object();
-    for (const std::string& c : columns) out[c] = row.contains(c) ? row.at(c) : json(nullptr);
-    return out;
-}
-
-// Every row of every task whose "kind" is `kind` (all rows when empty), in plan order.
-std::vector<json> rows_of(const SpecReduction& r, const std::string& kind = "") {
-    std::vector<json> rows;
-    for (const TaskResult& t : r.tasks)
-        for (const json& row : t.rows)
-            if (kind.empty() || row.value("kind", std::string()) == kind) rows.push_back(row);
-    return rows;
-}
-
-// The machine's load over the tasks that timed something (rows with load averages).
-std::optional<std::string> load_note(const std::vector<json>& rows) {
-    if (rows.empty() || !rows.front().contains("load_average_before")) return std::nullopt;
-    return "Load average (1 min) at the start of the first timed row: " + rows.front()["load_average_before"].dump() +
-           "; at the end of the last: " + rows.back()["load_average_after"].dump() + ".";
 }
 
 // ---- dag-structures: every structure on one model's voxels (Tables 1 and 2) ----
@@ -392,10 +242,6 @@ struct ConversionTimes {
         t_b.push_back(s.dedup_ms);
     }
 };
-
-std::string budget_text(uint64_t need, size_t budget) {
-    return "about " + std::to_string(need >> 20) + " MiB needed, budget " + std::to_string(budget >> 20) + " MiB";
-}
 
 // A whole-SVO conversion: voxels → SVO once, then SVO → SVDAG `reps` times at all threads
 // and under a 1-thread limit, with the codes → SVDAG phase the split rows time beside it.
@@ -793,6 +639,8 @@ ExperimentOutput reduce_fig13(const SpecReduction& r) {
 
 }  // namespace
 
+Experiment dag_scale_experiment();  // dag-scale, dag_scale_experiment.cpp
+
 void register_dag_experiments(ExperimentRegistry& registry) {
     add_probe("dag-structures", model_probe(measure_structures));
     add_probe("dag-conversion", model_probe(measure_conversion));
@@ -809,7 +657,7 @@ void register_dag_experiments(ExperimentRegistry& registry) {
         .figure = "Table 1",
         .description = "nodes and pointers of SVO, ESVO and SVDAG (plus OpenVDB and OctoMap) for the bunny, Buddha and "
                        "dragon at 1000³ (Table 1)",
-        .scenes = model_scenes(),
+        .scenes = paper_model_scenes(),
         .variants = {structures},
         .axes = {{"resolution", {1000}, {128}}},
         .reducer = "dag-table1",
@@ -832,7 +680,7 @@ void register_dag_experiments(ExperimentRegistry& registry) {
         .paper = "P2",
         .figure = "Table 2",
         .description = "storage of SVO, ESVO and SVDAG (plus OpenVDB and OctoMap) at 512³ and 1000³ (Table 2)",
-        .scenes = model_scenes(),
+        .scenes = paper_model_scenes(),
         .variants = {structures},
         .axes = {{"resolution", {512, 1000}, {64, 128}}},
         .reducer = "dag-table2",
@@ -857,7 +705,7 @@ void register_dag_experiments(ExperimentRegistry& registry) {
         .figure = "Table 3",
         .description = "SVO→SVDAG conversion time t_A and identical-node search time t_B, 128³ to 8192³, with the split "
                        "build and per-row peak memory (Table 3)",
-        .scenes = model_scenes(),
+        .scenes = paper_model_scenes(),
         .variants = {{.name = "SVO→SVDAG", .probe = "dag-conversion"}},
         .axes = {{"",
                   {row(128, "whole", 7, 256), row(256, "whole", 7, 256), row(512, "whole", 5, 256),
@@ -899,7 +747,7 @@ void register_dag_experiments(ExperimentRegistry& registry) {
         .paper = "P2",
         .figure = "Fig. 13",
         .description = "primary-ray throughput and nodes visited per ray through SVO, ESVO and SVDAG (Fig. 13)",
-        .scenes = model_scenes(),
+        .scenes = paper_model_scenes(),
         .size = 512, .quick_size = 128,
         .variants = {{.name = "SVO, ESVO, SVDAG",
                       .probe = "dag-traversal",
@@ -924,6 +772,7 @@ void register_dag_experiments(ExperimentRegistry& registry) {
                   "hitting rays spread evenly over the image. The paper plots times without numbers, so there is no "
                   "paper curve."},
     }));
+    registry.add(dag_scale_experiment());
 }
 
 }  // namespace gilab
