@@ -517,31 +517,7 @@ uint64_t Voxelizer::estimate_voxels(const VoxelRegion& region) const {
     return impl_->estimate_in(region.intersect(impl_->grid.full_region()));
 }
 
-std::vector<uint64_t> Voxelizer::touched_cells(int cell_log2) const {
-    const VoxelGrid& grid = impl_->grid;
-    cell_log2 = std::clamp(cell_log2, 0, grid.depth());
-    CellBox clip;
-    for (int k = 0; k < 3; ++k) {
-        clip.lo[k] = 0;
-        clip.hi[k] = ((int64_t(grid.resolution) - 1) >> cell_log2) + 1;
-    }
-    tbb::enumerable_thread_specific<std::vector<uint64_t>> local;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, impl_->triangles.size(), 256),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                          auto& cells = local.local();
-                          uint64_t tests = 0;
-                          for (size_t i = r.begin(); i < r.end(); ++i)
-                              rasterize(impl_->triangles[i], cell_log2, kCoarsePad, clip, tests,
-                                        [&](int64_t x, int64_t y, int64_t z) {
-                                            cells.push_back(morton_encode(uint32_t(x), uint32_t(y), uint32_t(z)));
-                                        });
-                      });
-    std::vector<uint64_t> cells;
-    for (auto& c : local) cells.insert(cells.end(), c.begin(), c.end());
-    tbb::parallel_sort(cells.begin(), cells.end());
-    cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
-    return cells;
-}
+std::vector<uint64_t> Voxelizer::touched_cells(int cell_log2) const { return bin_triangles(cell_log2).cells; }
 
 CellTriangles Voxelizer::bin_triangles(int cell_log2) const {
     const VoxelGrid& grid = impl_->grid;

@@ -107,9 +107,9 @@ public:
     // Aligned cells of 2^cell_log2 voxels per axis that some triangle overlaps, as the
     // Morton codes of the cell coordinates (cell = voxel >> cell_log2), ascending.
     std::vector<uint64_t> touched_cells(int cell_log2) const;
-    // Each triangle binned into the cells touched_cells counts it in (so bins.cells equals
-    // touched_cells). Throws Error before allocating when the (cell, triangle) pairs would
-    // exceed options().max_bytes.
+    // Each triangle binned into the cells it may overlap (bins.cells is touched_cells).
+    // Throws Error before allocating when the (cell, triangle) pairs would exceed
+    // options().max_bytes.
     CellTriangles bin_triangles(int cell_log2) const;
 
 private:
