@@ -43,7 +43,7 @@ GilabRun run_gilab(const std::vector<std::string>& args) {
         dup2(pipe_fds[1], 2);
         close(pipe_fds[0]);
         close(pipe_fds[1]);
-#if !defined(__SANITIZE_ADDRESS__)
+#if !defined(__SANITIZE_ADDRESS__) && !defined(GILAB_SANITIZED_BUILD)
         rlimit cap{rlim_t(4) << 30, rlim_t(4) << 30};
         setrlimit(RLIMIT_AS, &cap);
 #endif
