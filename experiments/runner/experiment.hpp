@@ -87,7 +87,7 @@ ExperimentOutput run_and_write(const Experiment& experiment, ExperimentContext c
 void register_core_experiments(ExperimentRegistry& registry);
 void register_photon_experiments(ExperimentRegistry& registry);    // P1: pm-table1..4, pm-fig8
 void register_stereo_experiments(ExperimentRegistry& registry);    // P1: pm-table5, pm-final, pm-foveated
-void register_dag_experiments(ExperimentRegistry& registry);       // P2: dag-table1..3, dag-fig13
+void register_dag_experiments(ExperimentRegistry& registry);       // P2: dag-table1..3, dag-fig13, dag-scale
 void register_shadow_dag_experiments(ExperimentRegistry& registry);  // P2: dag-table4, dag-fig15, dag-fig16-18
 void register_dynamic_dag_experiments(ExperimentRegistry& registry);  // P2: dag-table5, dag-table6
 void register_vct_experiments(ExperimentRegistry& registry);       // P3: vct-table1..7, vct-fig9..13, vct-stability
