@@ -11,6 +11,18 @@ std::optional<std::filesystem::path> shared_asset(const std::string& relative) {
     return AssetPaths::from_environment().find(relative);
 }
 
+// The build folder and the sanitizer pass are compiled into this file only, so that every
+// test's own code compiles to the same object in both builds (ccache, setup.sh).
+std::string gilab_program() { return std::string(GILAB_TEST_BINARY_DIR) + "/gilab"; }
+
+bool code_under_test_is_sanitized() {
+#if defined(__SANITIZE_ADDRESS__) || defined(GILAB_SANITIZED_BUILD)
+    return true;
+#else
+    return false;
+#endif
+}
+
 std::filesystem::path temp_dir(const std::string& name) {
     // CTest runs every test case as a process of its own, two at once: cases that ask for
     // the same name (the variants of a parameterised test) get a folder each, or one would

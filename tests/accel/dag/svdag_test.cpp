@@ -1,6 +1,7 @@
 // SVDAG: bottom-up merge decodes to the SVO's voxels, leaves no duplicate node on any
 // level, gives the same DAG from a split build, and the position API round-trips.
 #include <gtest/gtest.h>
+#include <algorithm>
 #include <bit>
 #include <map>
 #include <random>
@@ -10,8 +11,10 @@
 #include "accel/dag/svdag.hpp"
 #include "accel/dag/svo.hpp"
 #include "core/util/error.hpp"
+#include "core/io/mesh_loaders.hpp"
 #include "core/util/morton.hpp"
 #include "core/voxel/voxelizer.hpp"
+#include "tests/test_support.hpp"
 #include "tests/voxel_test_meshes.hpp"
 
 using namespace gilab;
@@ -132,6 +135,56 @@ TEST(Svdag, SplitBuildFromTheVoxelizerStreamsCells) {
         EXPECT_GE(dag.build_stats().subtrees, 1u);
         EXPECT_GT(dag.build_stats().voxelize_ms, 0.0);
     }
+}
+
+// Geometry lying exactly on the faces of the streamed build's cells: axis-aligned quads on
+// the planes x = 1/2, y = 1/4, z = 3/4 and a quad along the edge line x = y = 1/2.
+TEST(Svdag, StreamedBuildGivesTheInMemoryWordsWithGeometryOnCellFaces) {
+    gilab::test::TriangleSoup m;
+    auto quad = [&](Vec3 a, Vec3 b, Vec3 c, Vec3 d) { m.add(a, b, c); m.add(a, c, d); };
+    quad(Vec3(0.5f, 0.1f, 0.1f), Vec3(0.5f, 0.9f, 0.1f), Vec3(0.5f, 0.9f, 0.9f), Vec3(0.5f, 0.1f, 0.9f));
+    quad(Vec3(0.1f, 0.25f, 0.1f), Vec3(0.9f, 0.25f, 0.1f), Vec3(0.9f, 0.25f, 0.9f), Vec3(0.1f, 0.25f, 0.9f));
+    quad(Vec3(0.1f, 0.1f, 0.75f), Vec3(0.9f, 0.1f, 0.75f), Vec3(0.9f, 0.9f, 0.75f), Vec3(0.1f, 0.9f, 0.75f));
+    quad(Vec3(0.5f, 0.5f, 0.0f), Vec3(0.5f, 0.5f, 1.0f), Vec3(0.55f, 0.55f, 1.0f), Vec3(0.55f, 0.55f, 0.0f));
+    const VoxelGrid g = gilab::test::unit_grid(512);
+    Voxelizer vox(m.positions, m.triangles, g);
+    const Svdag in_memory = Svdag::from_voxels(vox.voxelize());
+    for (int split : {1, 2, 3, 5}) {  // cells of 256³, 128³, 64³ and 16³ voxels
+        const Svdag streamed = Svdag::from_voxelizer(vox, split);
+        EXPECT_TRUE(std::ranges::equal(streamed.words(), in_memory.words())) << "split level " << split;
+    }
+}
+
+// Real scenes, whose triangles cross the cells' faces everywhere: the streamed build
+// (voxelize a cell, merge its subtree, go on) gives the in-memory build's words.
+TEST(Svdag, StreamedBuildGivesTheInMemoryWordsOnSharedScenes) {
+    struct Case {
+        std::string asset;
+        uint32_t resolution;
+        std::vector<int> splits;
+    };
+    const Case cases[] = {{"bunny/stanford-bunny.obj", 512, {1, 4}},
+                          {"sponza/sponza.obj", 1024, {2, 5}},
+                          {"bunny/stanford-bunny.obj", 2048, {3}}};
+    std::string missing;
+    for (const Case& c : cases) {
+        const auto path = gilab::test::shared_asset(c.asset);
+        if (!path) {
+            missing += c.asset + " ";
+            continue;
+        }
+        const SceneFrame frame = load_mesh_file(*path).evaluate(0.0);
+        Voxelizer vox(frame, VoxelGrid::enclosing(frame.bounds, c.resolution));
+        const Svdag in_memory = Svdag::from_voxels(vox.voxelize());
+        ASSERT_GT(in_memory.node_count(), 1000u) << c.asset;
+        for (int split : c.splits) {
+            const Svdag streamed = Svdag::from_voxelizer(vox, split);
+            EXPECT_TRUE(std::ranges::equal(streamed.words(), in_memory.words()))
+                << c.asset << " at " << c.resolution << "³, split level " << split;
+            EXPECT_GT(streamed.build_stats().subtrees, 1u);
+        }
+    }
+    if (!missing.empty()) GTEST_SKIP() << "not found in the shared scenes: " << missing;
 }
 
 TEST(Svdag, FromSlicesRejectsBadSlices) {

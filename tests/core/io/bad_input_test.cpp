@@ -37,7 +37,7 @@ constexpr long kMaxGrowthKb = 200 * 1024;
 class AddressSpaceCap : public ::testing::Environment {
 public:
     void SetUp() override {
-#if !defined(__SANITIZE_ADDRESS__) && !defined(GILAB_SANITIZED_BUILD)
+        if (gilab::test::code_under_test_is_sanitized()) return;
         std::ifstream status("/proc/self/status");
         std::string line;
         while (std::getline(status, line))
@@ -46,7 +46,6 @@ public:
                 rlimit cap{used + (rlim_t(3) << 30), used + (rlim_t(3) << 30)};
                 setrlimit(RLIMIT_AS, &cap);
             }
-#endif
     }
 };
 const auto* const kCap = ::testing::AddGlobalTestEnvironment(new AddressSpaceCap);

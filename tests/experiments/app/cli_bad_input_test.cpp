@@ -30,7 +30,7 @@ struct GilabRun {
 // Runs the built binary without a shell (arguments pass through untouched, unicode
 // paths included), its address space capped so a regression fails fast.
 GilabRun run_gilab(const std::vector<std::string>& args) {
-    const std::string binary = std::string(GILAB_TEST_BINARY_DIR) + "/gilab";
+    const std::string binary = gilab::test::gilab_program();
     if (!fs::exists(binary)) {
         ADD_FAILURE() << binary << " is not built";
         return {};
@@ -43,10 +43,10 @@ GilabRun run_gilab(const std::vector<std::string>& args) {
         dup2(pipe_fds[1], 2);
         close(pipe_fds[0]);
         close(pipe_fds[1]);
-#if !defined(__SANITIZE_ADDRESS__) && !defined(GILAB_SANITIZED_BUILD)
-        rlimit cap{rlim_t(4) << 30, rlim_t(4) << 30};
-        setrlimit(RLIMIT_AS, &cap);
-#endif
+        if (!gilab::test::code_under_test_is_sanitized()) {
+            rlimit cap{rlim_t(4) << 30, rlim_t(4) << 30};
+            setrlimit(RLIMIT_AS, &cap);
+        }
         std::vector<char*> argv{const_cast<char*>(binary.c_str())};
         for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
         argv.push_back(nullptr);

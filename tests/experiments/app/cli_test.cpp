@@ -22,7 +22,7 @@ struct Result {
 };
 
 Result run(const std::string& args) {
-    std::string command = std::string(GILAB_TEST_BINARY_DIR) + "/gilab " + args + " 2>&1";
+    std::string command = gilab::test::gilab_program() + " " + args + " 2>&1";
     Result r{0, ""};
     FILE* pipe = popen(command.c_str(), "r");
     if (!pipe) return {-1, "popen failed"};

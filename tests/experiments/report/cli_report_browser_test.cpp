@@ -118,7 +118,7 @@ ProcessResult run_program(const std::vector<std::string>& argv, std::chrono::sec
 }
 
 ProcessResult run_gilab(const std::vector<std::string>& args) {
-    std::vector<std::string> argv{std::string(GILAB_TEST_BINARY_DIR) + "/gilab"};
+    std::vector<std::string> argv{gilab::test::gilab_program()};
     argv.insert(argv.end(), args.begin(), args.end());
     return run_program(argv, std::chrono::seconds(120));
 }

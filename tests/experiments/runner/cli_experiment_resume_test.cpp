@@ -25,7 +25,7 @@ struct Child {
 };
 
 Child start_gilab(const std::vector<std::string>& args) {
-    const std::string binary = std::string(GILAB_TEST_BINARY_DIR) + "/gilab";
+    const std::string binary = gilab::test::gilab_program();
     int fds[2];
     if (pipe(fds) != 0) return {};
     const pid_t pid = fork();

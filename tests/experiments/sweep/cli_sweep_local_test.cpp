@@ -27,7 +27,7 @@ std::string quoted(const std::string& text) { return "'" + text + "'"; }
 
 // Runs gilab with `args` (one shell word each) and `environment` (NAME=VALUE words or "").
 GilabRun run_gilab(const std::vector<std::string>& args, const std::string& environment = "") {
-    std::string command = environment + " " + quoted(std::string(GILAB_TEST_BINARY_DIR) + "/gilab");
+    std::string command = environment + " " + quoted(gilab::test::gilab_program());
     for (const std::string& a : args) {
         command += ' ';
         command += quoted(a);
