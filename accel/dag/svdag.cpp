@@ -2,6 +2,7 @@
 #include "accel/dag/child_mask.hpp"
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 #include <tbb/task_arena.h>
 #include "accel/dag/dag_level_table.hpp"
 #include "accel/dag/svdag_merger.hpp"
@@ -186,8 +187,14 @@ Svdag Svdag::from_voxels(const VoxelGrid& grid, std::span<const uint64_t> codes,
     return dag;
 }
 
+namespace {
+
+std::string mib_text(size_t bytes) { return std::to_string((bytes + (1u << 19)) >> 20) + " MiB"; }
+
+}  // namespace
+
 Svdag Svdag::from_slices(const VoxelGrid& grid, int split_level, std::span<const uint64_t> cells,
-                         const SliceSource& slice) {
+                         const SliceSource& slice, const SvdagStreamOptions& options) {
     Stopwatch clock;
     grid.validate("SVDAG");
     checked_split_level(grid, split_level);
@@ -202,6 +209,11 @@ Svdag Svdag::from_slices(const VoxelGrid& grid, int split_level, std::span<const
     for (size_t c = 0; c < cells.size(); ++c) {
         if (c > 0 && cells[c] <= cells[c - 1])
             throw Error("SVDAG", "split cells must be given in strictly ascending Morton order");
+        if (options.max_table_bytes > 0 && as.table_bytes() > options.max_table_bytes)
+            throw Error("SVDAG", "the merge tables hold " + mib_text(as.table_bytes()) + " after " + std::to_string(c) +
+                                     " of " + std::to_string(cells.size()) + " cells, over the build's limit of " +
+                                     mib_text(options.max_table_bytes));
+        if (options.progress && c > 0) options.progress(c, cells.size());
         Stopwatch t;
         std::vector<uint64_t> codes = slice(cells[c]);
         slice_ms += t.elapsed_ms();
@@ -214,6 +226,7 @@ Svdag Svdag::from_slices(const VoxelGrid& grid, int split_level, std::span<const
         voxels += codes.size();
         ++dag.stats_.subtrees;
     }
+    if (options.progress) options.progress(cells.size(), cells.size());
     as.finish_top(split_level, std::move(top_codes), std::move(top_ids));
     dag.stats_.table_bytes = as.table_bytes();
     as.assemble(dag);
@@ -226,32 +239,70 @@ Svdag Svdag::from_slices(const VoxelGrid& grid, int split_level, std::span<const
     return dag;
 }
 
-Svdag Svdag::from_voxelizer(const Voxelizer& voxelizer, int split_level) {
+Svdag Svdag::from_voxelizer(const Voxelizer& voxelizer, int split_level, const SvdagStreamOptions& options) {
     const VoxelGrid& grid = voxelizer.grid();
     checked_split_level(grid, split_level);
     const int cell_log2 = grid.depth() - split_level;
     // Each cell voxelizes only its own triangles, so the build's time grows with the
     // voxels, not with cells × the scene's triangles.
-    // A batch of cells, one per thread, is voxelized in parallel (a small cell's
-    // voxelization is mostly serial); the merge takes them in order.
     const CellTriangles bins = voxelizer.bin_triangles(cell_log2);
+    const size_t cell_count = bins.cells.size();
+    // A batch of cells, one per thread, is voxelized in parallel (a small cell's
+    // voxelization is mostly serial); the merge takes them in order, one at a time, while
+    // the next batch is voxelized: the merge is serial and would leave the other threads idle.
     const size_t batch_cells = size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
-    std::vector<std::vector<uint64_t>> batch;
-    size_t batch_begin = 0, next = 0;  // from_slices asks for the cells in ascending order
-    return from_slices(grid, split_level, bins.cells, [&](uint64_t cell) {
-        while (bins.cells[next] != cell) ++next;
-        if (next < batch_begin || next >= batch_begin + batch.size()) {
-            batch_begin = next;
-            batch.assign(std::min(batch_cells, bins.cells.size() - next), {});
-            tbb::parallel_for(size_t(0), batch.size(), [&](size_t i) {
-                VoxelRegion region;
-                region.begin = morton_decode(bins.cells[batch_begin + i]) << UVec3(uint32_t(cell_log2));
-                region.end = region.begin + UVec3(1u << cell_log2);
-                batch[i] = std::move(voxelizer.voxelize(region, bins.of(batch_begin + i)).codes);
-            });
+    struct Batch {
+        size_t begin = 0;
+        std::vector<std::vector<uint64_t>> codes;
+        bool holds(size_t i) const { return i >= begin && i < begin + codes.size(); }
+    };
+    auto voxelize_batch = [&](size_t begin, Batch& batch) {
+        batch.begin = begin;
+        batch.codes.assign(std::min(batch_cells, cell_count - begin), {});
+        tbb::parallel_for(size_t(0), batch.codes.size(), [&](size_t i) {
+            VoxelRegion region;
+            region.begin = morton_decode(bins.cells[begin + i]) << UVec3(uint32_t(cell_log2));
+            region.end = region.begin + UVec3(1u << cell_log2);
+            batch.codes[i] = std::move(voxelizer.voxelize(region, bins.of(begin + i)).codes);
+        });
+    };
+    Batch current, upcoming;
+    tbb::task_group ahead;
+    bool voxelizing_ahead = false;
+    // The batch being voxelized ahead refers to `upcoming`: wait for it on every way out.
+    struct WaitOnExit {
+        tbb::task_group& group;
+        bool& running;
+        ~WaitOnExit() {
+            if (!running) return;
+            group.cancel();
+            try {
+                group.wait();
+            } catch (...) {  // the build is already leaving with its own error
+            }
         }
-        return std::move(batch[next - batch_begin]);
-    });
+    } wait_on_exit{ahead, voxelizing_ahead};
+    size_t next = 0;  // from_slices asks for the cells in ascending order
+    return from_slices(
+        grid, split_level, bins.cells,
+        [&](uint64_t cell) {
+            while (bins.cells[next] != cell) ++next;
+            if (!current.holds(next)) {
+                if (voxelizing_ahead) {
+                    voxelizing_ahead = false;
+                    ahead.wait();  // rethrows the voxelizer's error
+                    std::swap(current, upcoming);
+                }
+                if (!current.holds(next)) voxelize_batch(next, current);
+                const size_t after = current.begin + current.codes.size();
+                if (after < cell_count) {
+                    voxelizing_ahead = true;
+                    ahead.run([&, after] { voxelize_batch(after, upcoming); });
+                }
+            }
+            return std::move(current.codes[next - current.begin]);
+        },
+        options);
 }
 
 uint32_t Svdag::child(uint32_t node, int slot) const {

@@ -11,7 +11,7 @@
 // A split build converts the subtrees below a chosen level one at a time (each from its
 // own contiguous slice of the Morton-sorted voxels, or voxelized on demand), joins
 // their roots and merges the levels above, so the peak memory is the finished DAG plus
-// one subtree (one per thread when they are voxelized on demand).
+// one subtree (two per thread when they are voxelized on demand).
 // The minimal DAG is unique, so every split level gives the same DAG.
 #include <cstdint>
 #include <functional>
@@ -46,6 +46,15 @@ struct DagLocation {
     uint32_t node = 0xffffffffu;    // address of that node
 };
 
+// How a split build fed cell by cell (from_slices, from_voxelizer) watches itself.
+struct SvdagStreamOptions {
+    // Bytes the merge tables may hold (0: no limit), checked before each cell: past it
+    // the build stops with an Error saying how far it got.
+    size_t max_table_bytes = 0;
+    // Called after each cell with the cells done and the cells in all.
+    std::function<void(size_t done, size_t cells)> progress;
+};
+
 class Svdag {
 public:
     Svdag() = default;
@@ -63,11 +72,13 @@ public:
     // voxels (global Morton codes, ascending). Only one slice is alive at a time.
     using SliceSource = std::function<std::vector<uint64_t>(uint64_t cell)>;
     static Svdag from_slices(const VoxelGrid& grid, int split_level, std::span<const uint64_t> cells,
-                             const SliceSource& slice);
+                             const SliceSource& slice, const SvdagStreamOptions& options = {});
     // Split build that voxelizes the level-`split_level` cells a batch at a time (one per
-    // thread, in parallel), each from only the triangles binned into it, so a grid far too large to
-    // hold as a voxel list still converts, in time that grows with its voxels.
-    static Svdag from_voxelizer(const Voxelizer& voxelizer, int split_level);
+    // thread, in parallel), each from only the triangles binned into it, so a grid far too
+    // large to hold as a voxel list still converts, in time that grows with its voxels.
+    // The next batch is voxelized while the current one is merged (two batches alive).
+    static Svdag from_voxelizer(const Voxelizer& voxelizer, int split_level,
+                                const SvdagStreamOptions& options = {});
 
     const VoxelGrid& grid() const { return grid_; }
     int depth() const { return depth_; }

@@ -1,4 +1,5 @@
 #include "accel/dag/svdag_merger.hpp"
+#include <bit>
 #include <string>
 #include "accel/dag/child_mask.hpp"
 #include "core/util/error.hpp"
@@ -9,12 +10,19 @@ namespace gilab {
 
 void check_voxel_codes(const VoxelGrid& grid, std::span<const uint64_t> codes, const char* where) {
     const uint32_t n = grid.resolution;
+    // In a power-of-two grid the codes of its voxels are exactly those below n³: no decode.
+    const bool power_of_two = std::has_single_bit(n) && n <= (1u << 21);
+    const uint64_t limit = power_of_two ? uint64_t(n) * n * n : 0;
+    auto outside = [&](uint64_t code) {
+        if (power_of_two) return code >= limit;
+        const UVec3 v = morton_decode(code);
+        return (code >> 63) || v.x >= n || v.y >= n || v.z >= n;
+    };
     for (size_t i = 0; i < codes.size(); ++i) {
         if (i > 0 && codes[i] <= codes[i - 1])
             throw Error(where, "voxel codes must be strictly ascending (Morton order); entry " + std::to_string(i) +
                                    " is not");
-        UVec3 v = morton_decode(codes[i]);
-        if ((codes[i] >> 63) || v.x >= n || v.y >= n || v.z >= n)
+        if (outside(codes[i]))
             throw Error(where, "voxel code " + std::to_string(codes[i]) + " lies outside the " + std::to_string(n) +
                                    "^3 grid");
     }

@@ -36,6 +36,9 @@ struct PreparedTriangle {
     bool planar = false;
     int w = 2, u = 0, v = 1;
     double c0 = 0, cu = 0, cv = 0;
+    // The first column_axes axes have no w component (the edges crossed with w): along a
+    // column of boxes in w they give one answer, tested once per column.
+    int column_axes = 0;
 };
 
 PreparedTriangle prepare(const DVec3& a, const DVec3& b, const DVec3& c) {
@@ -71,6 +74,15 @@ PreparedTriangle prepare(const DVec3& a, const DVec3& b, const DVec3& c) {
         t.cu = -n[t.u] / n[t.w];
         t.cv = -n[t.v] / n[t.w];
         t.c0 = a[t.w] - t.cu * a[t.u] - t.cv * a[t.v];
+        // Any axis separates the box or not whatever its place in the list.
+        for (int i = 0; i < t.axis_count; ++i)
+            if (t.axis[i][t.w] == 0.0) {
+                std::swap(t.axis[i], t.axis[t.column_axes]);
+                std::swap(t.amin[i], t.amin[t.column_axes]);
+                std::swap(t.amax[i], t.amax[t.column_axes]);
+                std::swap(t.radius[i], t.radius[t.column_axes]);
+                ++t.column_axes;
+            }
     }
     return t;
 }
@@ -99,6 +111,81 @@ inline int64_t clamp_to_index(double x, int64_t lo, int64_t hi) {
     return static_cast<int64_t>(std::clamp(x, double(lo), double(hi)));
 }
 
+// `overlaps` split for a column of boxes along the plane's dominant axis W (t.w), with
+// the same arithmetic, so with the same answers: the part that is the same for the whole
+// column (the bounding box along u and v, the axes without a w component, whose w term is
+// 0 for any centre) ... W is a template parameter: components picked at compile time stay
+// in registers.
+template <int W>
+inline bool column_overlaps(const PreparedTriangle& t, const DVec3& bmin, double size) {
+    constexpr int U = (W + 1) % 3, V = (W + 2) % 3;
+    if (t.lo[U] > bmin[U] + size || t.lo[V] > bmin[V] + size || t.hi[U] < bmin[U] || t.hi[V] < bmin[V])
+        return false;
+    const DVec3 center = bmin + DVec3(0.5 * size);
+    for (int i = 0; i < t.column_axes; ++i) {
+        double s = glm::dot(t.axis[i], center);
+        double r = t.radius[i] * size;
+        if (t.amin[i] > s + r || t.amax[i] < s - r) return false;
+    }
+    return true;
+}
+
+// ... and the rest, for one box of the column: `center` is the box's centre.
+template <int W>
+inline bool overlaps_in_column(const PreparedTriangle& t, double bmin_w, const DVec3& center, double size) {
+    if (t.lo[W] > bmin_w + size || t.hi[W] < bmin_w) return false;
+    for (int i = t.column_axes; i < t.axis_count; ++i) {
+        double s = glm::dot(t.axis[i], center);
+        double r = t.radius[i] * size;
+        if (t.amin[i] > s + r || t.amax[i] < s - r) return false;
+    }
+    return true;
+}
+
+// The planar case of `rasterize`: candidates per column of the projection along W come
+// from the plane's height range over the column.
+template <int W, class Emit>
+void rasterize_columns(const PreparedTriangle& t, const int64_t (&lo)[3], const int64_t (&hi)[3], double s, double pad,
+                       uint64_t& tests, Emit&& emit) {
+    constexpr int U = (W + 1) % 3, V = (W + 2) % 3;
+    constexpr double kEps = 1e-6;
+    const double inv = 1.0 / s;
+    const double box = s + 2 * pad;
+    int64_t cell[3];
+    for (int64_t b = lo[V]; b <= hi[V]; ++b) {
+        double v0 = double(b) * s - pad, v1 = double(b + 1) * s + pad;
+        double hv_min = t.cv >= 0 ? t.cv * v0 : t.cv * v1;
+        double hv_max = t.cv >= 0 ? t.cv * v1 : t.cv * v0;
+        for (int64_t a = lo[U]; a <= hi[U]; ++a) {
+            double u0 = double(a) * s - pad, u1 = double(a + 1) * s + pad;
+            double zmin = t.c0 + hv_min + (t.cu >= 0 ? t.cu * u0 : t.cu * u1);
+            double zmax = t.c0 + hv_max + (t.cu >= 0 ? t.cu * u1 : t.cu * u0);
+            zmin = std::max(zmin, t.lo[W]) - pad;
+            zmax = std::min(zmax, t.hi[W]) + pad;
+            int64_t k0 = std::max(lo[W], clamp_to_index(std::ceil(zmin * inv - 1.0 - kEps), lo[W] - 1, hi[W] + 1));
+            int64_t k1 = std::min(hi[W], clamp_to_index(std::floor(zmax * inv + kEps), lo[W] - 1, hi[W] + 1));
+            if (k0 > k1) continue;
+            // Every candidate counts as a box test, as when each was tested whole.
+            tests += uint64_t(k1 - k0 + 1);
+            DVec3 bmin(0.0);
+            bmin[U] = double(a) * s - pad;
+            bmin[V] = double(b) * s - pad;
+            if (!column_overlaps<W>(t, bmin, box)) continue;
+            DVec3 center = bmin + DVec3(0.5 * box);
+            cell[U] = a;
+            cell[V] = b;
+            for (int64_t k = k0; k <= k1; ++k) {
+                const double bmin_w = double(k) * s - pad;
+                center[W] = bmin_w + 0.5 * box;
+                if (overlaps_in_column<W>(t, bmin_w, center, box)) {
+                    cell[W] = k;
+                    emit(cell[0], cell[1], cell[2]);
+                }
+            }
+        }
+    }
+}
+
 // Calls emit(x, y, z) for every cell of 2^log2 voxels inside `clip` that the triangle
 // overlaps, each cell grown by `pad` on every side (coarse cells are padded so they
 // never miss a voxel that the exact per-voxel test accepts). Candidates per column of
@@ -115,10 +202,10 @@ void rasterize(const PreparedTriangle& t, int log2, double pad, const CellBox& c
         hi[i] = std::min(clip.hi[i] - 1, clamp_to_index(std::floor((t.hi[i] + pad) * inv), clip.lo[i] - 1, clip.hi[i] + 1));
         if (lo[i] > hi[i]) return;
     }
-    int64_t cell[3];
+    const double box = s + 2 * pad;
     auto test = [&](int64_t x, int64_t y, int64_t z) {
         ++tests;
-        if (overlaps(t, DVec3(double(x), double(y), double(z)) * s - DVec3(pad), s + 2 * pad)) emit(x, y, z);
+        if (overlaps(t, DVec3(double(x), double(y), double(z)) * s - DVec3(pad), box)) emit(x, y, z);
     };
     if (!t.planar) {
         for (int64_t z = lo[2]; z <= hi[2]; ++z)
@@ -126,27 +213,10 @@ void rasterize(const PreparedTriangle& t, int log2, double pad, const CellBox& c
                 for (int64_t x = lo[0]; x <= hi[0]; ++x) test(x, y, z);
         return;
     }
-    const int u = t.u, v = t.v, w = t.w;
-    constexpr double kEps = 1e-6;
-    for (int64_t b = lo[v]; b <= hi[v]; ++b) {
-        double v0 = double(b) * s - pad, v1 = double(b + 1) * s + pad;
-        double hv_min = t.cv >= 0 ? t.cv * v0 : t.cv * v1;
-        double hv_max = t.cv >= 0 ? t.cv * v1 : t.cv * v0;
-        for (int64_t a = lo[u]; a <= hi[u]; ++a) {
-            double u0 = double(a) * s - pad, u1 = double(a + 1) * s + pad;
-            double zmin = t.c0 + hv_min + (t.cu >= 0 ? t.cu * u0 : t.cu * u1);
-            double zmax = t.c0 + hv_max + (t.cu >= 0 ? t.cu * u1 : t.cu * u0);
-            zmin = std::max(zmin, t.lo[w]) - pad;
-            zmax = std::min(zmax, t.hi[w]) + pad;
-            int64_t k0 = std::max(lo[w], clamp_to_index(std::ceil(zmin * inv - 1.0 - kEps), lo[w] - 1, hi[w] + 1));
-            int64_t k1 = std::min(hi[w], clamp_to_index(std::floor(zmax * inv + kEps), lo[w] - 1, hi[w] + 1));
-            cell[u] = a;
-            cell[v] = b;
-            for (int64_t k = k0; k <= k1; ++k) {
-                cell[w] = k;
-                test(cell[0], cell[1], cell[2]);
-            }
-        }
+    switch (t.w) {
+        case 0: rasterize_columns<0>(t, lo, hi, s, pad, tests, emit); break;
+        case 1: rasterize_columns<1>(t, lo, hi, s, pad, tests, emit); break;
+        default: rasterize_columns<2>(t, lo, hi, s, pad, tests, emit); break;
     }
 }
 

@@ -32,26 +32,29 @@ using namespace p2;
 // dag-table3's split rule: subtrees of at most 2^8 = 256 voxels per axis.
 constexpr int kSubtreeLog2 = 8;
 
-// Memory guard, from the voxelizer's estimate of the voxels (above the true count).
-// At 2048³ the SVDAG took 0.04–0.52 B per estimated voxel on our scenes (the most on the
-// Happy Buddha) and fewer at finer grids (Bunny: 0.34, 0.32, 0.28 B at 2048³, 4096³,
-// 8192³). The row's peak holds the SVDAG with its merge tables while building, then the
-// SSVDAG conversion and the checks beside it: about 4 times the SVDAG on the Bunny at
-// 8192³. The subtrees being voxelized (one per thread) add their voxels (8 B each).
-constexpr double kDagBytesPerEstimatedVoxel = 0.6;
-constexpr double kPeakOverDag = 5;
+// Rows are attempted up to this many voxels by the voxelizer's estimate (above the true
+// count): over an hour of voxelizing on a two-core machine at the 17 million voxels a
+// second per thread measured on Sponza. Memory is watched while the row builds.
+constexpr uint64_t kMaxRowEstimatedVoxels = uint64_t(1) << 37;
+// While the streamed build runs, the cells being voxelized (two batches of one cell per
+// thread, 8 B per voxel) sit beside its merge tables; the tables get the rest of the
+// row's budget and the build stops with a note past it. After the build, the SSVDAG
+// conversion and the checks work beside the SVDAG: the row's peak was 4.1 times the
+// SVDAG's bytes on the Happy Buddha at 32768³, so 5 times must fit the budget.
+constexpr double kAfterBuildOverDag = 5;
 // Literal decodes hold both voxel lists (8 B per voxel each, up to twice that while a
 // list grows): only up to this many voxels, and only within the row's memory budget.
 constexpr uint64_t kDecodeVoxelLimit = uint64_t(1) << 26;
 constexpr uint64_t kDecodeBytesPerVoxel = 32;
+// A long build reports how far it got at most this often.
+constexpr double kProgressEverySeconds = 60;
 
-uint64_t estimated_row_bytes(const Voxelizer& voxelizer, int split_level, int threads) {
+uint64_t cells_in_flight_bytes(const Voxelizer& voxelizer, int split_level, int threads) {
     const VoxelGrid& grid = voxelizer.grid();
     const uint64_t voxels = voxelizer.estimate_voxels(grid.full_region());
     const int cell_log2 = grid.depth() - split_level;
     const uint64_t cell_volume = uint64_t(1) << (3 * std::min(cell_log2, 20));
-    const double subtrees = 8.0 * double(std::min(voxels, cell_volume * uint64_t(threads)));
-    return uint64_t(kPeakOverDag * kDagBytesPerEstimatedVoxel * double(voxels) + subtrees);
+    return 8 * std::min(voxels, 2 * cell_volume * uint64_t(threads));
 }
 
 // The SVDAG's bytes with its level depth-1 nodes (the voxels' parents) stored as the
@@ -184,12 +187,32 @@ void measure_scale(const ProbeCall& call, const Model& model, ProbeOutput& out) 
     const int split_level = std::max(0, voxelizer.grid().depth() - kSubtreeLog2);
     const size_t budget = available_memory_bytes() / 2;
     const int threads = ctx.threads > 0 ? ctx.threads : default_thread_count();
-    const uint64_t need = estimated_row_bytes(voxelizer, split_level, threads);
-    if (need > budget) {
-        out.notes.push_back(row_name + " skipped: " + budget_text(need, budget));
-        ctx.say(row_name + ": skipped, " + budget_text(need, budget));
+    auto skip = [&](const std::string& why) {
+        out.notes.push_back(row_name + " skipped: " + why);
+        ctx.say(row_name + ": skipped, " + why);
+    };
+    const uint64_t estimated_voxels = voxelizer.estimate_voxels(voxelizer.grid().full_region());
+    if (estimated_voxels > kMaxRowEstimatedVoxels) {
+        skip("about " + std::to_string(estimated_voxels) +
+             " voxels by the voxelizer's estimate, more than the 2³⁷ a row voxelizes");
         return;
     }
+    const uint64_t in_flight = cells_in_flight_bytes(voxelizer, split_level, threads);
+    if (in_flight >= budget) {
+        skip(budget_text(in_flight, budget) + " for the cells being voxelized");
+        return;
+    }
+    SvdagStreamOptions stream;
+    stream.max_table_bytes = budget - in_flight;
+    Stopwatch progress_watch;
+    double last_progress_s = 0;
+    stream.progress = [&](size_t done, size_t cells) {
+        const double now = seconds_of(progress_watch);
+        if (done == cells || now - last_progress_s < kProgressEverySeconds) return;
+        last_progress_s = now;
+        ctx.say(row_name + ": " + std::to_string(done * 100 / cells) + " % of " + std::to_string(cells) +
+                " cells merged, " + std::to_string(int(now)) + " s");
+    };
     const double load_before = load_average();
     if (!reset_peak_rss())
         out.notes.push_back("VmHWM could not be reset on this system: peak_rss_MiB is process-wide.");
@@ -203,14 +226,24 @@ void measure_scale(const ProbeCall& call, const Model& model, ProbeOutput& out) 
             ctx.say(row_name + ": SVDAG, " + build_text + ", 1 thread");
             ThreadLimit one(1);
             Stopwatch watch;
-            Svdag::from_voxelizer(voxelizer, split_level);
+            progress_watch = Stopwatch();
+            last_progress_s = 0;
+            Svdag::from_voxelizer(voxelizer, split_level, stream);
             single_thread_s = seconds_of(watch);
         }
         ctx.say(row_name + ": SVDAG, " + build_text + ", all threads");
         Stopwatch build_watch;
-        const Svdag svdag = Svdag::from_voxelizer(voxelizer, split_level);
+        progress_watch = Stopwatch();
+        last_progress_s = 0;
+        const Svdag svdag = Svdag::from_voxelizer(voxelizer, split_level, stream);
         const double build_s = seconds_of(build_watch);
         const uint64_t voxels = svdag.build_stats().input_nodes;
+        const uint64_t need = uint64_t(kAfterBuildOverDag * double(svdag.bytes()));
+        if (need > budget) {
+            skip(budget_text(need, budget) + " for the SSVDAG conversion and the checks beside the " +
+                 std::to_string(svdag.bytes() >> 20) + " MiB SVDAG (built in " + std::to_string(int(build_s)) + " s)");
+            return;
+        }
         ctx.say(row_name + ": " + std::to_string(voxels) + " voxels, " + std::to_string(svdag.node_count()) +
                 " SVDAG nodes; SVDAG → SSVDAG");
         Stopwatch convert_watch;
@@ -220,7 +253,9 @@ void measure_scale(const ProbeCall& call, const Model& model, ProbeOutput& out) 
         ctx.say(row_name + ": comparing the two DAGs");
         const bool same = same_octree(svdag, ssvdag);
         json decode_equal = nullptr;
-        uint64_t allowed = need;  // the guards' estimate of what the row adds
+        // What the guards allowed for: the larger of the build's tables with the cells in
+        // flight and the work after the build, plus the literal decode where it ran.
+        uint64_t allowed = std::max<uint64_t>(svdag.build_stats().table_bytes + in_flight, need);
         if (voxels <= kDecodeVoxelLimit && need + kDecodeBytesPerVoxel * voxels <= budget) {
             allowed += kDecodeBytesPerVoxel * voxels;
             decode_equal = svdag.decode() == ssvdag.decode();
@@ -272,8 +307,8 @@ void measure_scale(const ProbeCall& call, const Model& model, ProbeOutput& out) 
             out.notes.push_back(row_name + ": the SSVDAG disagrees with the SVDAG (see same_octree, decode_equal, "
                                            "rays_disagreeing)");
     } catch (const Error& e) {
-        // A DAG beyond its pointers' reach (2^32 SVDAG words, 2^29 SSVDAG words), or a
-        // voxelization over the voxelizer's own budget.
+        // A DAG beyond its pointers' reach (2^32 SVDAG words, 2^29 SSVDAG words), merge
+        // tables past their limit, or a voxelization over the voxelizer's own budget.
         out.notes.push_back(row_name + " skipped: " + e.what());
         ctx.say(row_name + ": skipped, " + e.what());
     }
@@ -404,8 +439,9 @@ Experiment dag_scale_experiment() {
             "Sponza, Sibenik and the conference room whole, each as placed by its scene file in scenes/, in the "
             "smallest cube enclosing its bounding box, grown by 0.1% per side (VoxelGrid::enclosing). Voxels are "
             "conservative surface voxels (triangle/box overlap), not solid.",
-            "SVDAG: Svdag::from_voxelizer, the split build of dag-table3: each 256³ subtree voxelized on its own, "
-            "merged into shared per-level tables, the roots joined (split level = depth − 8; grids of 256³ and "
+            "SVDAG: Svdag::from_voxelizer, the split build of dag-table3 streamed: each 256³ subtree voxelized on "
+            "its own (a batch of one per thread, the next batch voxelized while this one merges), merged into "
+            "shared per-level tables, the roots joined (split level = depth − 8; grids of 256³ and "
             "below are built whole, in one piece). Stored in P2's format: a 4 B mask word per node + 4 B per child "
             "pointer, and one word for the voxel node. svdag_build (s) is the wall time of the whole call, "
             "voxelization included; voxelize_share (s/s) is the part spent voxelizing. The 1-thread build runs "
@@ -433,15 +469,17 @@ Experiment dag_scale_experiment() {
             "ray_repetitions passes each; rays_disagreeing counts rays whose hit or hit voxel differs (0 "
             "expected).",
             "Memory: peak_rss_MiB is the row's own peak resident memory (VmHWM reset through /proc/self/clear_refs "
-            "before the row), including what the process held before it (rss_before_MiB). Before building, a row "
-            "is skipped with a note when what it would add (estimated_rss_MiB) exceeds half the available memory: "
-            "the voxelizer's estimate_voxels (above the true count) × 0.6 B of SVDAG per estimated voxel (at most "
-            "0.52 B measured at 2048³, less on finer grids) × 5 for the merge tables, the conversion and the checks "
-            "beside it, plus the voxels of the subtrees being voxelized (one per thread). A row whose resolution "
-            "exceeds the grid's 2²¹, or whose DAG is beyond its pointers' reach (2³² SVDAG words, 2²⁹ SSVDAG "
-            "words), is skipped with a note too. The literal decode (decode_equal) adds up to 32 B per voxel: it "
-            "runs only when that fits the budget too, once the voxel count is known, and estimated_rss_MiB "
-            "includes it where it ran.",
+            "before the row), including what the process held before it (rss_before_MiB). The row's budget is half "
+            "the available memory. The cells being voxelized (two batches of one 256³ cell per thread, 8 B per "
+            "voxel by the voxelizer's estimate) must fit it; the streamed build's merge tables get the rest and are "
+            "checked before every cell: past it the row stops with a note saying how far it got. After the build, "
+            "5 × the SVDAG's bytes must fit the budget for the SSVDAG conversion and the checks (the row's peak was "
+            "4.1 × the SVDAG on the Happy Buddha at 32768³), or the row is skipped with a note giving the SVDAG's "
+            "size and build time. estimated_rss_MiB is the larger of the two allowances. A row whose voxelizer "
+            "estimate exceeds 2³⁷ voxels (over an hour of voxelizing on two cores), whose resolution exceeds the "
+            "grid's 2²¹, or whose DAG is beyond its pointers' reach (2³² SVDAG words, 2²⁹ SSVDAG words), is skipped "
+            "with a note too. The literal decode (decode_equal) adds up to 32 B per voxel: it runs only when that "
+            "fits the budget too, once the voxel count is known, and estimated_rss_MiB includes it where it ran.",
             "paper: SSVDAG (Villanueva, Marton & Gobbetti 2016/2017) stores PowerPlant at 64K³ in 86 MB against "
             "167 MB as an SVDAG (0.123 bits per voxel) and averages 52.4 % of the SVDAG's bytes over its scenes; "
             "Kämpe et al. 2013 store Epic Citadel at 128K³ (19 G voxels) in 945 MB. None of these scenes is among "

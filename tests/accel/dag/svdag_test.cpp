@@ -13,6 +13,7 @@
 #include "core/util/error.hpp"
 #include "core/io/mesh_loaders.hpp"
 #include "core/util/morton.hpp"
+#include "core/util/parallel.hpp"
 #include "core/voxel/voxelizer.hpp"
 #include "tests/test_support.hpp"
 #include "tests/voxel_test_meshes.hpp"
@@ -185,6 +186,39 @@ TEST(Svdag, StreamedBuildGivesTheInMemoryWordsOnSharedScenes) {
         }
     }
     if (!missing.empty()) GTEST_SKIP() << "not found in the shared scenes: " << missing;
+}
+
+// The streamed build reports each cell as it goes, and stops with an Error naming how
+// far it got when its merge tables pass their limit; at any thread count it gives the
+// same words (the next batch is voxelized while one merges).
+TEST(Svdag, StreamedBuildReportsProgressAndStopsAtItsTableLimit) {
+    auto m = gilab::test::uv_sphere(Vec3(0.45f, 0.5f, 0.55f), 0.37f, 16, 32);
+    Voxelizer vox(m.positions, m.triangles, gilab::test::unit_grid(256));
+    const Svdag whole = Svdag::from_voxels(vox.voxelize());
+    std::vector<size_t> done;
+    size_t cells = 0;
+    SvdagStreamOptions options;
+    options.progress = [&](size_t d, size_t c) {
+        done.push_back(d);
+        cells = c;
+    };
+    const Svdag streamed = Svdag::from_voxelizer(vox, 3, options);
+    EXPECT_TRUE(std::ranges::equal(streamed.words(), whole.words()));
+    ASSERT_GT(cells, 8u);
+    ASSERT_FALSE(done.empty());
+    EXPECT_TRUE(std::ranges::is_sorted(done));
+    EXPECT_EQ(done.back(), cells);
+    for (int threads : {1, 2}) {
+        ThreadLimit limit(threads);
+        EXPECT_TRUE(std::ranges::equal(Svdag::from_voxelizer(vox, 3).words(), whole.words())) << threads << " threads";
+    }
+
+    options.progress = nullptr;
+    options.max_table_bytes = whole.build_stats().table_bytes / 4;
+    ASSERT_GT(options.max_table_bytes, 0u);
+    const std::string error = gilab::test::error_of([&] { Svdag::from_voxelizer(vox, 3, options); });
+    EXPECT_NE(error.find("merge tables hold"), std::string::npos) << error;
+    EXPECT_NE(error.find("of " + std::to_string(cells) + " cells"), std::string::npos) << error;
 }
 
 TEST(Svdag, FromSlicesRejectsBadSlices) {
