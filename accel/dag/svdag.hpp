@@ -29,7 +29,7 @@ namespace gilab {
 struct SvdagBuildStats {
     double total_ms = 0;       // t_A: the whole conversion to the final storage
     double dedup_ms = 0;       // t_B: hashing nodes and looking up identical ones
-    double voxelize_ms = 0;    // split builds fed by a voxelizer: time spent voxelizing
+    double voxelize_ms = 0;    // split builds fed cell by cell: time spent waiting for the cells
     uint64_t input_nodes = 0;  // SVO nodes read (from_svo) or voxels read (other builds)
     uint64_t subtrees = 0;     // subtrees converted separately (split builds)
     int split_level = 0;

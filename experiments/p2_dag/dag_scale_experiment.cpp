@@ -444,7 +444,7 @@ Experiment dag_scale_experiment() {
             "shared per-level tables, the roots joined (split level = depth − 8; grids of 256³ and "
             "below are built whole, in one piece). Stored in P2's format: a 4 B mask word per node + 4 B per child "
             "pointer, and one word for the voxel node. svdag_build (s) is the wall time of the whole call, "
-            "voxelization included; voxelize_share (s/s) is the part spent voxelizing. The 1-thread build runs "
+            "voxelization included; voxelize_share (s/s) is the part the merge spent waiting for voxelized cells (the rest of the voxelizing overlaps the merge). The 1-thread build runs "
             "first under a TBB limit of one thread (ThreadLimit), then the all-thread build the rest of the row "
             "uses.",
             "SSVDAG: Ssvdag::from_svdag (accel/dag/ssvdag.hpp) on that SVDAG, all threads, wall time. Implemented "
