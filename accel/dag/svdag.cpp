@@ -7,6 +7,7 @@
 #include "accel/dag/dag_level_table.hpp"
 #include "accel/dag/svdag_merger.hpp"
 #include "core/util/error.hpp"
+#include "core/util/memory_budget.hpp"
 #include "core/util/morton.hpp"
 
 namespace gilab {
@@ -187,12 +188,6 @@ Svdag Svdag::from_voxels(const VoxelGrid& grid, std::span<const uint64_t> codes,
     return dag;
 }
 
-namespace {
-
-std::string mib_text(size_t bytes) { return std::to_string((bytes + (1u << 19)) >> 20) + " MiB"; }
-
-}  // namespace
-
 Svdag Svdag::from_slices(const VoxelGrid& grid, int split_level, std::span<const uint64_t> cells,
                          const SliceSource& slice, const SvdagStreamOptions& options) {
     Stopwatch clock;
@@ -210,9 +205,9 @@ Svdag Svdag::from_slices(const VoxelGrid& grid, int split_level, std::span<const
         if (c > 0 && cells[c] <= cells[c - 1])
             throw Error("SVDAG", "split cells must be given in strictly ascending Morton order");
         if (options.max_table_bytes > 0 && as.table_bytes() > options.max_table_bytes)
-            throw Error("SVDAG", "the merge tables hold " + mib_text(as.table_bytes()) + " after " + std::to_string(c) +
+            throw Error("SVDAG", "the merge tables hold " + MemoryBudget::format(as.table_bytes()) + " after " + std::to_string(c) +
                                      " of " + std::to_string(cells.size()) + " cells, over the build's limit of " +
-                                     mib_text(options.max_table_bytes));
+                                     MemoryBudget::format(options.max_table_bytes));
         if (options.progress && c > 0) options.progress(c, cells.size());
         Stopwatch t;
         std::vector<uint64_t> codes = slice(cells[c]);
