@@ -164,14 +164,16 @@ void ssvdag_size(benchmark::State& state, const std::string& name) {
     }
     for (auto _ : state) {
         const Ssvdag s = Ssvdag::from_svdag(d->svdag);
-        benchmark::DoNotOptimize(s.words().data());
+        benchmark::DoNotOptimize(s.units().data());
     }
     state.counters["svdag_nodes"] = double(d->svdag.node_count());
     state.counters["ssvdag_nodes"] = double(d->ssvdag.node_count());
     state.counters["svdag_bytes"] = double(d->svdag.bytes());
     state.counters["ssvdag_bytes"] = double(d->ssvdag.bytes());
     state.counters["bytes_ratio"] = double(d->ssvdag.bytes()) / double(d->svdag.bytes());
+    state.counters["ssvdag_word_bytes"] = double(d->ssvdag.word_bytes());
     state.counters["mirrored_pointers"] = double(d->ssvdag.mirrored_pointer_count());
+    state.counters["long_pointers"] = double(d->ssvdag.long_pointer_count());
     state.counters["voxels"] = double(d->ssvdag.voxel_count());
 }
 

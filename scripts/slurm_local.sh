@@ -110,6 +110,10 @@ MpiDefault=none
 MailProg=/bin/true
 ReturnToService=2
 SchedulerType=sched/backfill
+# A core that frees up takes the next array task at once; by default the controller starts
+# batch jobs at most every 3 s (batch_sched_delay), which left a core idle between short
+# tasks (20 tasks of 0.3 s on 2 cores: 30 s by default, 10 s with this).
+SchedulerParameters=batch_sched_delay=0
 MinJobAge=300
 # Without a default, a job would take the whole node's memory and array tasks would run one at a time.
 DefMemPerCPU=1024

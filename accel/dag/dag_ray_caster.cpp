@@ -13,7 +13,7 @@ struct WordNodes {
     uint32_t root_address;
     DagWalkNode root() const { return {root_address, 0}; }
     uint32_t mask(DagWalkNode node, bool) const { return words[node.address] & 0xffu; }
-    DagWalkNode child(DagWalkNode node, uint32_t mask, uint32_t slot) const {
+    DagWalkNode child(DagWalkNode node, uint32_t mask, uint32_t slot, int) const {
         return {words[node.address + 1 + child_rank(mask, int(slot))], 0};
     }
 };

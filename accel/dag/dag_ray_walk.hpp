@@ -8,8 +8,8 @@
 // A DAG format plugs in its nodes through `Nodes`:
 //   DagWalkNode root() const;
 //   uint32_t mask(DagWalkNode node, bool voxel_parent) const;   // 8-bit child mask
-//   DagWalkNode child(DagWalkNode node, uint32_t mask, uint32_t stored_slot) const;
-// voxel_parent: the node's children are voxels. A node may be stored reflected (SSVDAG):
+//   DagWalkNode child(DagWalkNode node, uint32_t mask, uint32_t stored_slot, int level) const;
+// voxel_parent: the node's children are voxels; level: the node's, 0 at the root. A node may be stored reflected (SSVDAG):
 // `child` returns the pointer's own mirror, and the walk composes the mirrors along the
 // path, so the cell in slot k of a node seen through mirror m is its stored slot k ^ m.
 // Formats without mirrors return 0, which the compiler folds away.
@@ -113,7 +113,7 @@ VoxelRayHit walk_dag_ray(const Nodes& nodes, const VoxelGrid& grid, int depth, c
                 }
                 // Push: descend into the child, remembering where to resume.
                 stack[scale] = {parent, t_max};
-                const DagWalkNode child = nodes.child(parent, mask, stored_slot);
+                const DagWalkNode child = nodes.child(parent, mask, stored_slot, kMaxScale - 1 - scale);
                 parent = {child.address, parent.mirror ^ child.mirror};
                 const float half = scale_exp2 * 0.5f;
                 --scale;

@@ -114,7 +114,7 @@ uint32_t encode_ssvdag_pointer(uint64_t address, uint32_t mirror) {
     return mirror << kSsvdagMirrorShift | uint32_t(address);
 }
 
-// The level-by-level conversion and the layout into words.
+// The level-by-level conversion and the layout into units.
 class SsvdagBuilder {
 public:
     explicit SsvdagBuilder(const Svdag& dag) : dag_(dag), depth_(dag.depth()) {}
@@ -212,57 +212,123 @@ private:
         return b;
     }
 
-    // Interior levels top-down, then the leaf masks; pointers turn ids into addresses.
+    // How many pointers of level `level` reach each node of level `level` + 1, by id.
+    std::vector<uint32_t> references_to_level_below(int level, size_t below_count) const {
+        std::vector<uint32_t> refs(below_count, 0);
+        const DagLevelTable& t = tables_[size_t(level)];
+        for (uint32_t u = 0; u < t.size(); ++u)
+            for (uint32_t ref : t.children(u)) ++refs[ref_id(ref)];
+        return refs;
+    }
+
+    // The storage order of a level's nodes: most references per unit first, ties by id (so
+    // the order, and the units, are the same for every build). Returns each id's offset
+    // from the level's start in units; `total` gets the level's units.
+    static std::vector<uint32_t> order_by_references(const std::vector<uint32_t>& refs,
+                                                     const std::vector<uint8_t>& units, uint64_t& total) {
+        std::vector<uint32_t> ids(refs.size());
+        for (uint32_t i = 0; i < ids.size(); ++i) ids[i] = i;
+        std::sort(ids.begin(), ids.end(), [&](uint32_t a, uint32_t b) {
+            const uint64_t da = uint64_t(refs[a]) * units[b], db = uint64_t(refs[b]) * units[a];
+            return da != db ? da > db : a < b;
+        });
+        std::vector<uint32_t> offset(refs.size());
+        total = 0;
+        for (uint32_t id : ids) {
+            offset[id] = uint32_t(std::min<uint64_t>(total, kSsvdagAddressLimit));
+            total += units[id];
+        }
+        return offset;
+    }
+
+    // Levels ordered bottom-up (a node's size depends on which of its children sit within
+    // a short pointer's reach), then laid out top-down, then the leaf masks.
     void lay_out(Ssvdag& out, uint32_t root_ref) {
         const int interior = depth_ - 1;  // levels stored as header + pointers
-        std::vector<std::vector<uint32_t>> address(interior);
+        // offset[l][id]: from level l's start, in units (mask index on level depth-1).
+        std::vector<std::vector<uint32_t>> offset(static_cast<size_t>(depth_));
+        std::vector<uint64_t> level_units(size_t(interior), 0);
+        uint64_t leaf_total = 0;
+        {
+            const std::vector<uint32_t> refs = depth_ == 1 ? std::vector<uint32_t>(leaf_masks_.size(), 1)
+                                                            : references_to_level_below(interior - 1, leaf_masks_.size());
+            offset[size_t(interior)] = order_by_references(refs, std::vector<uint8_t>(leaf_masks_.size(), 1), leaf_total);
+        }
+        const auto is_short = [](uint32_t child_offset) { return child_offset < kSsvdagShortOffsetLimit; };
+        for (int l = interior - 1; l >= 0; --l) {
+            const DagLevelTable& t = tables_[size_t(l)];
+            std::vector<uint8_t> units(t.size());
+            for (uint32_t u = 0; u < t.size(); ++u) {
+                uint32_t n = 1;
+                for (uint32_t ref : t.children(u)) n += is_short(offset[size_t(l + 1)][ref_id(ref)]) ? 1 : 2;
+                units[u] = uint8_t(n);
+            }
+            const std::vector<uint32_t> refs =
+                l == 0 ? std::vector<uint32_t>(t.size(), 1) : references_to_level_below(l - 1, t.size());
+            offset[size_t(l)] = order_by_references(refs, units, level_units[size_t(l)]);
+        }
+
         out.level_begin_.assign(size_t(interior) + 1, 0);
         uint64_t next = 0;
         for (int l = 0; l < interior; ++l) {
-            const DagLevelTable& t = tables_[l];
-            out.level_begin_[l] = next;
-            out.level_counts_[l] = t.size();
-            address[l].resize(t.size());
-            for (uint32_t u = 0; u < t.size(); ++u) {
-                address[l][u] = uint32_t(std::min<uint64_t>(next, kSsvdagAddressLimit));
-                next += 1 + t.children(u).size();
-            }
-            out.pointer_count_ += t.child_count_total();
+            out.level_begin_[size_t(l)] = next;
+            out.level_counts_[size_t(l)] = tables_[size_t(l)].size();
+            out.pointer_count_ += tables_[size_t(l)].child_count_total();
+            out.word_bytes_ += 4 * (tables_[size_t(l)].size() + tables_[size_t(l)].child_count_total());
+            next += level_units[size_t(l)];
         }
-        out.level_begin_[interior] = next;
-        out.level_counts_[depth_ - 1] = leaf_masks_.size();
-        // Every interior address must fit a pointer; checked before allocating the words.
+        out.level_begin_[size_t(interior)] = next;
+        out.level_counts_[size_t(depth_ - 1)] = leaf_masks_.size();
+        out.word_bytes_ += 4 * ((leaf_masks_.size() + 3) / 4);
+        // Every interior address must fit a long pointer; checked before allocating the units.
         if (next > kSsvdagAddressLimit)
             throw Error("SSVDAG", "the DAG needs " + std::to_string(next) +
-                                      " words of nodes, more than the 2^29 that 29-bit pointers address");
-        const uint64_t leaf_words = (leaf_masks_.size() + 3) / 4;
+                                      " units of nodes, more than the 2^29 that 29-bit pointers address");
+        out.child_level_begin_.assign(size_t(std::max(interior, 0)), 0);
+        for (int l = 0; l + 1 < interior; ++l) out.child_level_begin_[size_t(l)] = uint32_t(out.level_begin_[size_t(l + 1)]);
         out.leaf_begin_ = uint32_t(next);
-        out.words_.assign(next + leaf_words, 0);
-        for (size_t i = 0; i < leaf_masks_.size(); ++i)
-            out.words_[next + i / 4] |= uint32_t(leaf_masks_[i]) << (8 * (i % 4));
+        out.units_.assign(next + (leaf_masks_.size() + 1) / 2, 0);
+        for (size_t id = 0; id < leaf_masks_.size(); ++id) {
+            const uint32_t index = offset[size_t(interior)][id];
+            out.units_[next + index / 2] |= uint16_t(uint32_t(leaf_masks_[id]) << (8 * (index % 2)));
+        }
 
         for (int l = 0; l < interior; ++l) {
-            const DagLevelTable& t = tables_[l];
-            // Below the last interior level a child is a leaf mask, named by its index.
-            const std::vector<uint32_t>* below = l + 1 < interior ? &address[l + 1] : nullptr;
+            const DagLevelTable& t = tables_[size_t(l)];
+            const std::vector<uint32_t>& below = offset[size_t(l + 1)];
+            const uint32_t below_begin = out.child_level_begin_[size_t(l)];
+            const uint64_t begin = out.level_begin_[size_t(l)];
             tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(t.size()), 4096),
                               [&](const tbb::blocked_range<uint32_t>& r) {
                                   for (uint32_t u = r.begin(); u < r.end(); ++u) {
-                                      const uint32_t a = address[l][u];
-                                      out.words_[a] = t.header(u);
+                                      const uint32_t header = t.header(u);
                                       const auto kids = t.children(u);
-                                      for (size_t k = 0; k < kids.size(); ++k) {
-                                          const uint32_t id = ref_id(kids[k]);
-                                          out.words_[a + 1 + k] = ref_mirror(kids[k]) << kSsvdagMirrorShift |
-                                                                  (below ? (*below)[id] : id);
+                                      uint16_t* node = out.units_.data() + begin + offset[size_t(l)][u];
+                                      uint32_t long_mask = 0, at = 1;
+                                      for (uint32_t slot = 0, k = 0; slot < 8; ++slot) {
+                                          if (!(header & (1u << slot))) continue;
+                                          const uint32_t child_offset = below[ref_id(kids[k])];
+                                          const uint32_t mirror = ref_mirror(kids[k++]);
+                                          if (is_short(child_offset)) {
+                                              node[at++] = uint16_t(mirror << kSsvdagShortMirrorShift | child_offset);
+                                          } else {
+                                              const uint32_t word = mirror << kSsvdagMirrorShift | (below_begin + child_offset);
+                                              node[at++] = uint16_t(word & 0xffffu);
+                                              node[at++] = uint16_t(word >> 16);
+                                              long_mask |= 1u << slot;
+                                          }
                                       }
+                                      node[0] = uint16_t(header | long_mask << 8);
                                   }
                               });
             for (uint32_t u = 0; u < t.size(); ++u)
-                for (uint32_t ref : t.children(u)) out.mirrored_pointer_count_ += ref_mirror(ref) != 0;
-            std::vector<uint32_t>().swap(address[l]);
+                for (uint32_t ref : t.children(u)) {
+                    out.mirrored_pointer_count_ += ref_mirror(ref) != 0;
+                    out.long_pointer_count_ += !is_short(below[ref_id(ref)]);
+                }
+            std::vector<uint32_t>().swap(offset[size_t(l)]);
         }
-        out.root_ = {0, ref_mirror(root_ref)};
+        out.root_ = {depth_ == 1 ? offset[0][ref_id(root_ref)] : 0u, ref_mirror(root_ref)};
     }
 
     const Svdag& dag_;
@@ -279,7 +345,7 @@ std::optional<SsvdagPointer> Ssvdag::child(const SsvdagPointer& node, int level,
     const uint32_t m = stored_mask(node.address, level);
     if (!(m & (1u << stored_slot))) return std::nullopt;
     if (level == depth_ - 1) return SsvdagPointer{0, node.mirror};  // a voxel: not stored
-    SsvdagPointer c = decode_ssvdag_pointer(words_[node.address + 1 + child_rank(m, int(stored_slot))]);
+    SsvdagPointer c = stored_child(node.address, level, stored_slot);
     c.mirror ^= node.mirror;
     return c;
 }
@@ -291,7 +357,8 @@ std::vector<uint32_t> Ssvdag::level_nodes(int level) const {
         for (uint32_t i = 0; i < level_counts_[level]; ++i) nodes.push_back(i);
         return nodes;
     }
-    for (uint64_t a = level_begin_[level]; a < level_begin_[level + 1]; a += 1 + child_count(words_[a]))
+    for (uint64_t a = level_begin_[level]; a < level_begin_[level + 1];
+         a += 1 + child_count(units_[a]) + child_count(units_[a] >> 8))
         nodes.push_back(uint32_t(a));
     return nodes;
 }
@@ -313,9 +380,9 @@ uint64_t Ssvdag::voxel_count() const {
     for (int l = depth_ - 2; l >= 0; --l) {
         const std::vector<uint64_t>& source = l == depth_ - 2 ? leaf_voxels : below;
         for (uint32_t a : level_nodes(l)) {
-            const uint32_t k = child_count(words_[a]);
             uint64_t sum = 0;
-            for (uint32_t i = 0; i < k; ++i) sum += source[decode_ssvdag_pointer(words_[a + 1 + i]).address];
+            for (uint32_t slot = 0; slot < 8; ++slot)
+                if (units_[a] & (1u << slot)) sum += source[stored_child(a, l, slot).address];
             below[a] = sum;
         }
     }
@@ -370,7 +437,9 @@ Stats Ssvdag::stats() const {
     s.set("nodes", double(node_count()));
     s.set("pointers", double(pointer_count()));
     s.set("mirrored_pointers", double(mirrored_pointer_count()));
+    s.set("long_pointers", double(long_pointer_count()));
     s.set("bytes", double(bytes()));
+    s.set("word_bytes", double(word_bytes()));
     s.set("convert_ms", stats_.total_ms);
     s.set("dedup_ms", stats_.dedup_ms);
     s.set("input_nodes", double(stats_.input_nodes));

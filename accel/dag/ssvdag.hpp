@@ -14,25 +14,32 @@
 // unique minimal SSVDAG over reflections: the same for every build and thread count.
 //
 // Implemented from the paper: merging under the 8 reflections along the grid axes, the
-// mirror carried in each pointer, and ray casting with the mirror applied to the child
-// order (ssvdag_ray_caster.hpp). Not implemented: the variable-bit-rate pointers (16-bit
-// pointers to the most referenced nodes), 4³-voxel leaves as 64-bit masks and the
-// out-of-core build.
+// mirror carried in each pointer, variable-size pointers (16 bits to the nodes that most
+// pointers reach, 32 bits to the rest) and ray casting with the mirror applied to the
+// child order (ssvdag_ray_caster.hpp). Not implemented: 4³-voxel leaves as 64-bit masks
+// and the paper's out-of-core build (gilab streams the SVDAG instead, svdag.hpp).
 //
-// Storage, all 32-bit words; addresses count words:
-// - levels 0..depth-2, laid out top-down from address 0: per node a header word (its
-//   8-bit child mask) and then, per non-empty child in slot order, a pointer word
-//   mirror << 29 | address (29-bit address, so at most 2^29 words);
-// - level depth-1 (nodes whose children are voxels): their 8-bit masks, four to a word,
-//   after the last interior level; pointers to them hold the mask's index;
+// Storage, 16-bit units; addresses count units:
+// - levels 0..depth-2, laid out top-down from address 0. Within a level the nodes are
+//   ordered by pointers reaching them per unit they take, most first (ties by id), so
+//   that the most reached ones sit within a short pointer's reach of the level's start.
+//   Per node a header unit, child mask | long-pointer mask << 8 (bit k: the pointer of
+//   slot k is long), then per non-empty child in slot order its pointer:
+//     short, one unit: mirror << 13 | the child's offset from its level's first unit;
+//     long, two units (low first): mirror << 29 | the child's address;
+//   a pointer is short exactly when the offset is below 2^13;
+// - level depth-1 (nodes whose children are voxels): their 8-bit masks, two to a unit,
+//   after the last interior level, ordered by pointers reaching them; pointers to them
+//   hold the mask's index (which is also its offset);
 // - level depth (the voxel) is not stored.
 // The root's pointer (address 0, or mask index 0 when depth is 1, and its mirror) is
-// kept beside the words.
+// kept beside the units.
 #include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
 #include <vector>
+#include "accel/dag/child_mask.hpp"
 #include "accel/dag/svdag.hpp"
 #include "core/util/math.hpp"
 #include "core/util/stats.hpp"
@@ -40,9 +47,14 @@
 
 namespace gilab {
 
+// Long pointers: 29-bit address, 3-bit mirror.
 inline constexpr int kSsvdagMirrorShift = 29;
 inline constexpr uint32_t kSsvdagAddressLimit = 1u << kSsvdagMirrorShift;  // addresses below this
 inline constexpr uint32_t kSsvdagAddressMask = kSsvdagAddressLimit - 1;
+// Short pointers: 13-bit offset from the child level's start, 3-bit mirror.
+inline constexpr int kSsvdagShortMirrorShift = 13;
+inline constexpr uint32_t kSsvdagShortOffsetLimit = 1u << kSsvdagShortMirrorShift;  // offsets below this
+inline constexpr uint32_t kSsvdagShortOffsetMask = kSsvdagShortOffsetLimit - 1;
 
 // A reference to a stored node: its address (word address, or mask index on level
 // depth-1) and the reflection under which it is seen.
@@ -52,7 +64,8 @@ struct SsvdagPointer {
     bool operator==(const SsvdagPointer&) const = default;
 };
 
-// Throws Error when the address needs more than 29 bits or the mirror more than 3.
+// A long pointer's 32 bits. Throws Error when the address needs more than 29 bits or the
+// mirror more than 3.
 uint32_t encode_ssvdag_pointer(uint64_t address, uint32_t mirror);
 inline SsvdagPointer decode_ssvdag_pointer(uint32_t word) {
     return {word & kSsvdagAddressMask, word >> kSsvdagMirrorShift};
@@ -89,25 +102,41 @@ class Ssvdag {
 public:
     Ssvdag() = default;
 
-    // Throws Error when the result would need addresses of 2^29 words or more (checked
-    // before the words are allocated).
+    // Throws Error when the result would need addresses of 2^29 units or more (checked
+    // before the units are allocated).
     static Ssvdag from_svdag(const Svdag& dag);
 
     const VoxelGrid& grid() const { return grid_; }
     int depth() const { return depth_; }
     bool empty() const { return empty_; }
-    std::span<const uint32_t> words() const { return words_; }
+    std::span<const uint16_t> units() const { return units_; }
     // The root as stored: address 0 (mask index 0 when depth is 1) and its mirror.
     SsvdagPointer root() const { return root_; }
-    uint32_t leaf_begin() const { return leaf_begin_; }  // word where the level depth-1 masks start
+    uint32_t leaf_begin() const { return leaf_begin_; }  // unit where the level depth-1 masks start
+    // Where level `level` < depth-1 starts; level depth-1 is addressed by mask index.
+    uint32_t level_begin(int level) const { return uint32_t(level_begin_[size_t(level)]); }
 
     // Stored mask of a node on level < depth (unreflected).
     uint8_t stored_mask(uint32_t address, int level) const {
-        return level == depth_ - 1 ? leaf_mask(address) : static_cast<uint8_t>(words_[address] & 0xffu);
+        return level == depth_ - 1 ? leaf_mask(address) : static_cast<uint8_t>(units_[address] & 0xffu);
     }
     uint8_t leaf_mask(uint32_t index) const {
-        return static_cast<uint8_t>(words_[leaf_begin_ + (index >> 2)] >> (8 * (index & 3u)));
+        return static_cast<uint8_t>(units_[leaf_begin_ + (index >> 1)] >> (8 * (index & 1u)));
     }
+    // The pointer in stored slot `stored_slot` (non-empty) of the node at `address` on
+    // interior level `level` < depth-1, as stored (its own mirror, not composed).
+    SsvdagPointer stored_child(uint32_t address, int level, uint32_t stored_slot) const {
+        const uint32_t header = units_[address];
+        const uint32_t before = (1u << stored_slot) - 1u;
+        const uint32_t at = address + 1 + child_count(header & before) + child_count((header >> 8) & before);
+        if ((header >> (8 + stored_slot)) & 1u)
+            return decode_ssvdag_pointer(uint32_t(units_[at]) | uint32_t(units_[at + 1]) << 16);
+        const uint32_t unit = units_[at];
+        return {(unit & kSsvdagShortOffsetMask) + child_level_begin_[size_t(level)], unit >> kSsvdagShortMirrorShift};
+    }
+    // Where the level below each interior level starts (0 for level depth-1, addressed by
+    // index): what a short pointer's offset is added to.
+    const uint32_t* child_level_begins() const { return child_level_begin_.data(); }
     // Child mask of a node as seen through its pointer's mirror.
     uint8_t mask(const SsvdagPointer& node, int level) const {
         return reflect_mask(stored_mask(node.address, level), node.mirror);
@@ -121,7 +150,11 @@ public:
     size_t node_count() const;  // stored nodes plus the implicit voxel node
     size_t pointer_count() const { return pointer_count_; }
     size_t mirrored_pointer_count() const { return mirrored_pointer_count_; }  // pointers with a mirror
-    size_t bytes() const { return words_.size() * sizeof(uint32_t); }
+    size_t long_pointer_count() const { return long_pointer_count_; }          // pointers of 32 bits
+    size_t bytes() const { return units_.size() * sizeof(uint16_t); }
+    // Bytes of the same nodes with every header and pointer a 32-bit word and the masks
+    // of level depth-1 four to a word: what merging under reflections alone gives.
+    size_t word_bytes() const { return word_bytes_; }
     // Stored nodes per level, depth+1 entries; level `depth` counts the one voxel node
     // (not stored), as Svdag counts its one leaf.
     const std::vector<uint64_t>& level_node_counts() const { return level_counts_; }
@@ -132,8 +165,8 @@ public:
     std::vector<uint64_t> decode() const;  // Morton codes of all voxels, ascending
 
     const SsvdagBuildStats& build_stats() const { return stats_; }
-    // nodes, pointers, mirrored_pointers, bytes, convert_ms, dedup_ms, input_nodes,
-    // table_bytes, nodes_level_<k>.
+    // nodes, pointers, mirrored_pointers, long_pointers, bytes, word_bytes, convert_ms,
+    // dedup_ms, input_nodes, table_bytes, nodes_level_<k>.
     Stats stats() const;
 
 private:
@@ -141,13 +174,16 @@ private:
     VoxelGrid grid_;
     int depth_ = 0;
     bool empty_ = true;
-    std::vector<uint32_t> words_;
+    std::vector<uint16_t> units_;
     SsvdagPointer root_;
     uint32_t leaf_begin_ = 0;
     std::vector<uint64_t> level_counts_;
-    std::vector<uint64_t> level_begin_;  // word address where each interior level starts; depth entries
+    std::vector<uint64_t> level_begin_;          // unit where each interior level starts, then leaf_begin_
+    std::vector<uint32_t> child_level_begin_;    // per interior level: where the level below starts
     size_t pointer_count_ = 0;
     size_t mirrored_pointer_count_ = 0;
+    size_t long_pointer_count_ = 0;
+    size_t word_bytes_ = 0;
     SsvdagBuildStats stats_;
 };
 

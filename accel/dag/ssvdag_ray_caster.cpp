@@ -7,19 +7,19 @@
 namespace gilab {
 namespace {
 
-// The SSVDAG's words: interior nodes as the SVDAG's with mirrored pointers, the voxels'
-// parents as bytes, four to a word, named by index.
+// The SSVDAG's units: interior nodes as a header and short or long mirrored pointers, the
+// voxels' parents as bytes, two to a unit, named by index.
 struct MirroredNodes {
-    const uint32_t* words;
+    const Ssvdag& dag;
+    const uint16_t* units;
     uint32_t leaf_begin;
-    DagWalkNode root_node;
-    DagWalkNode root() const { return root_node; }
+    DagWalkNode root() const { return {dag.root().address, dag.root().mirror}; }
     uint32_t mask(DagWalkNode node, bool voxel_parent) const {
-        if (voxel_parent) return (words[leaf_begin + (node.address >> 2)] >> (8 * (node.address & 3u))) & 0xffu;
-        return words[node.address] & 0xffu;
+        if (voxel_parent) return (units[leaf_begin + (node.address >> 1)] >> (8 * (node.address & 1u))) & 0xffu;
+        return units[node.address] & 0xffu;
     }
-    DagWalkNode child(DagWalkNode node, uint32_t mask, uint32_t slot) const {
-        const SsvdagPointer p = decode_ssvdag_pointer(words[node.address + 1 + child_rank(mask, int(slot))]);
+    DagWalkNode child(DagWalkNode node, uint32_t, uint32_t slot, int level) const {
+        const SsvdagPointer p = dag.stored_child(node.address, level, slot);
         return {p.address, p.mirror};
     }
 };
@@ -28,7 +28,7 @@ struct MirroredNodes {
 
 VoxelRayHit cast_ssvdag_ray(const Ssvdag& dag, const Ray& ray) {
     if (dag.empty()) return {};
-    const MirroredNodes nodes{dag.words().data(), dag.leaf_begin(), {dag.root().address, dag.root().mirror}};
+    const MirroredNodes nodes{dag, dag.units().data(), dag.leaf_begin()};
     return walk_dag_ray(nodes, dag.grid(), dag.depth(), ray);
 }
 

@@ -58,10 +58,11 @@ uint64_t cells_in_flight_bytes(const Voxelizer& voxelizer, int split_level, int 
 }
 
 // The SVDAG's bytes with its level depth-1 nodes (the voxels' parents) stored as the
-// SSVDAG stores them: their 8-bit masks, four to a word, in place of a mask word plus one
-// pointer per voxel each, and no word for the voxel node. Pointers to them keep their 4
-// bytes (they would hold the mask's index). This is the SSVDAG's layout without the
-// mirror merging, so ssvdag / this is what merging under reflections alone saves.
+// SSVDAG's 32-bit layout stores them: their 8-bit masks, four to a word, in place of a
+// mask word plus one pointer per voxel each, and no word for the voxel node. Pointers to
+// them keep their 4 bytes (they would hold the mask's index). This is
+// Ssvdag::word_bytes() without the mirror merging, so word_bytes / this is what merging
+// under reflections alone saves.
 uint64_t svdag_bytes_with_packed_leaves(const Svdag& dag) {
     if (dag.empty() || dag.depth() == 0) return dag.bytes();
     const int depth = dag.depth();
@@ -266,6 +267,7 @@ void measure_scale(const ProbeCall& call, const Model& model, ProbeOutput& out) 
         const RayFigures rf = cast_both(svdag, ssvdag, rays, ray_reps);
 
         const double svdag_bytes = double(svdag.bytes()), ssvdag_bytes = double(ssvdag.bytes());
+        const double ssvdag_word_bytes = double(ssvdag.word_bytes());
         const double packed_bytes = double(svdag_bytes_with_packed_leaves(svdag));
         const double voxel_count = double(voxels);
         out.rows.push_back(
@@ -281,8 +283,11 @@ void measure_scale(const ProbeCall& call, const Model& model, ProbeOutput& out) 
              {"ssvdag_over_svdag", ratio(ssvdag_bytes, svdag_bytes)},
              {"ssvdag_over_svdag_nodes", ratio(double(ssvdag.node_count()), double(svdag.node_count()))},
              {"svdag_packed_leaves_MB", mb(packed_bytes)},
-             {"ssvdag_over_packed_leaves", ratio(ssvdag_bytes, packed_bytes)},
+             {"ssvdag_words_MB", mb(ssvdag_word_bytes)},
+             {"ssvdag_words_over_packed_leaves", ratio(ssvdag_word_bytes, packed_bytes)},
+             {"ssvdag_over_ssvdag_words", ratio(ssvdag_bytes, ssvdag_word_bytes)},
              {"mirrored_pointer_share", ratio(double(ssvdag.mirrored_pointer_count()), double(ssvdag.pointer_count()))},
+             {"long_pointer_share", ratio(double(ssvdag.long_pointer_count()), double(ssvdag.pointer_count()))},
              {"bits_per_voxel_svdag", ratio(8 * svdag_bytes, voxel_count)},
              {"bits_per_voxel_ssvdag", ratio(8 * ssvdag_bytes, voxel_count)},
              {"svdag_build (s), all threads", build_s},
@@ -307,7 +312,7 @@ void measure_scale(const ProbeCall& call, const Model& model, ProbeOutput& out) 
             out.notes.push_back(row_name + ": the SSVDAG disagrees with the SVDAG (see same_octree, decode_equal, "
                                            "rays_disagreeing)");
     } catch (const Error& e) {
-        // A DAG beyond its pointers' reach (2^32 SVDAG words, 2^29 SSVDAG words), merge
+        // A DAG beyond its pointers' reach (2^32 SVDAG words, 2^29 SSVDAG units), merge
         // tables past their limit, or a voxelization over the voxelizer's own budget.
         out.notes.push_back(row_name + " skipped: " + e.what());
         ctx.say(row_name + ": skipped, " + e.what());
@@ -326,8 +331,11 @@ const std::vector<std::string> kColumns = {"scene",
                                            "ssvdag_over_svdag",
                                            "ssvdag_over_svdag_nodes",
                                            "svdag_packed_leaves_MB",
-                                           "ssvdag_over_packed_leaves",
+                                           "ssvdag_words_MB",
+                                           "ssvdag_words_over_packed_leaves",
+                                           "ssvdag_over_ssvdag_words",
                                            "mirrored_pointer_share",
+                                           "long_pointer_share",
                                            "bits_per_voxel_svdag",
                                            "bits_per_voxel_ssvdag",
                                            "svdag_build (s), all threads",
@@ -352,7 +360,7 @@ ResultTable summary_table(const std::vector<json>& rows, const std::vector<json>
     ResultTable t;
     t.title = "Mean over the rows present, per resolution and over all rows";
     t.columns = {"resolution", "rows", "mean_ssvdag_over_svdag", "mean_ssvdag_over_svdag_nodes",
-                 "mean_ssvdag_over_packed_leaves"};
+                 "mean_ssvdag_words_over_packed_leaves", "mean_ssvdag_over_ssvdag_words"};
     auto summarize = [&](const json& resolution) {
         // The column's values over the rows at `resolution` (all rows for "all").
         auto values = [&](const char* column) {
@@ -371,7 +379,8 @@ ResultTable summary_table(const std::vector<json>& rows, const std::vector<json>
                           {"rows", values("ssvdag_over_svdag").size()},
                           {"mean_ssvdag_over_svdag", mean_of("ssvdag_over_svdag")},
                           {"mean_ssvdag_over_svdag_nodes", mean_of("ssvdag_over_svdag_nodes")},
-                          {"mean_ssvdag_over_packed_leaves", mean_of("ssvdag_over_packed_leaves")}});
+                          {"mean_ssvdag_words_over_packed_leaves", mean_of("ssvdag_words_over_packed_leaves")},
+                          {"mean_ssvdag_over_ssvdag_words", mean_of("ssvdag_over_ssvdag_words")}});
     };
     for (const json& resolution : resolutions) summarize(resolution);
     summarize("all");
@@ -449,17 +458,23 @@ Experiment dag_scale_experiment() {
             "uses.",
             "SSVDAG: Ssvdag::from_svdag (accel/dag/ssvdag.hpp) on that SVDAG, all threads, wall time. Implemented "
             "from the paper: subtrees equal up to any of the 8 reflections along the grid axes merged, the 3-bit "
-            "mirror carried in each 32-bit pointer (29-bit addresses), the voxels' parents stored as 8-bit masks "
-            "four to a word, and ray casting with the mirror applied to the child order. Not implemented: the "
-            "paper's variable-bit-rate pointers (16-bit pointers to the most referenced nodes), 4³-voxel leaves as "
-            "64-bit masks and its out-of-core build, so our SSVDAG is larger than the paper's encoding would be.",
+            "mirror carried in each pointer, variable-size pointers and ray casting with the mirror applied to the "
+            "child order. Storage in 16-bit units: a node is a header unit (child mask, and a bit per child whose "
+            "pointer is long) and per child a short pointer (one unit: mirror and a 13-bit offset from the child "
+            "level's start) or a long one (two units: mirror and a 29-bit address); each level is ordered by "
+            "pointers reaching a node per unit it takes, most first, so the most reached nodes sit within a short "
+            "pointer's reach; the voxels' parents are 8-bit masks, two to a unit. The paper's exact pointer "
+            "encoding differs in detail. Not implemented: 4³-voxel leaves as 64-bit masks and the paper's "
+            "out-of-core build (the SVDAG is streamed instead).",
             "svdag_packed_leaves_MB is the SVDAG's size if its level depth−1 nodes (the voxels' parents) were "
-            "stored as the SSVDAG stores them (8-bit masks four to a word, no voxel node word), computed from the "
-            "SVDAG's level node counts and its layout: the SSVDAG's layout without any mirror merging. "
-            "ssvdag_over_packed_leaves is therefore what merging under reflections saves by itself, and "
-            "svdag_packed_leaves_MB / svdag_MB what the leaf packing saves. Node counts include the voxel node "
-            "(stored by the SVDAG, implicit in the SSVDAG). mirrored_pointer_share = SSVDAG pointers with a "
-            "non-zero mirror / all its pointers. bits_per_voxel = 8 × bytes / voxels.",
+            "stored as 8-bit masks four to a word (no voxel node word), computed from the SVDAG's level node "
+            "counts and its layout. ssvdag_words_MB is the SSVDAG's nodes with every header and pointer a 32-bit "
+            "word and the same packed masks. So ssvdag_words_over_packed_leaves is what merging under reflections "
+            "saves by itself, ssvdag_over_ssvdag_words what the short pointers save, and svdag_packed_leaves_MB / "
+            "svdag_MB what the leaf packing saves. Node counts include the voxel node (stored by the SVDAG, "
+            "implicit in the SSVDAG). mirrored_pointer_share = SSVDAG pointers with a non-zero mirror / all its "
+            "pointers; long_pointer_share = its 32-bit pointers / all its pointers. bits_per_voxel = 8 × bytes / "
+            "voxels.",
             "Checks: same_octree walks both DAGs from the root together and compares the child masks at every pair "
             "of nodes met (each SVDAG node once per SSVDAG pointer it meets: the DAGs' size, not the voxel count), "
             "which holds exactly when the two hold the same voxels; decode_equal compares the two decoded voxel "
@@ -477,7 +492,7 @@ Experiment dag_scale_experiment() {
             "4.1 × the SVDAG on the Happy Buddha at 32768³), or the row is skipped with a note giving the SVDAG's "
             "size and build time. estimated_rss_MiB is the larger of the two allowances. A row whose voxelizer "
             "estimate exceeds 2³⁷ voxels (over an hour of voxelizing on two cores), whose resolution exceeds the "
-            "grid's 2²¹, or whose DAG is beyond its pointers' reach (2³² SVDAG words, 2²⁹ SSVDAG words), is skipped "
+            "grid's 2²¹, or whose DAG is beyond its pointers' reach (2³² SVDAG words, 2²⁹ SSVDAG units), is skipped "
             "with a note too. The literal decode (decode_equal) adds up to 32 B per voxel: it runs only when that "
             "fits the budget too, once the voxel count is known, and estimated_rss_MiB includes it where it ran.",
             "paper: SSVDAG (Villanueva, Marton & Gobbetti 2016/2017) stores PowerPlant at 64K³ in 86 MB against "

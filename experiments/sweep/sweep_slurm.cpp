@@ -135,15 +135,18 @@ std::string task_list_text(const Sweep& sweep, const std::vector<SweepTask>& tas
 }
 
 std::string array_script(const Sweep& sweep, const SlurmSweepOptions& o, size_t task_count, int round, ArrayKind kind) {
-    const size_t indices = (task_count + size_t(o.batch) - 1) / size_t(o.batch);
-    const std::string r = std::to_string(round);
     const bool references = kind == ArrayKind::References;
+    // Reference groups are few and each a long render: one per index, so that they spread
+    // over the nodes (--batch is for many cheap tasks).
+    const int batch = references ? 1 : o.batch;
+    const size_t indices = (task_count + size_t(batch) - 1) / size_t(batch);
+    const std::string r = std::to_string(round);
     const std::string verb = references ? "references" : "run-task";
     std::ostringstream s;
     s << "#!/bin/bash\n"
       << "# gilab sweep, round " << r << ": " << task_count << (references ? " reference group(s)" : " task(s)") << " in "
       << indices << " array index(es). Index i\n"
-      << "# runs lines i*" << o.batch << "+1 to i*" << o.batch << "+" << o.batch
+      << "# runs lines i*" << batch << "+1 to i*" << batch << "+" << batch
       << " of the list, each as `gilab experiment " << verb << "`, which\n"
       << (references ? "# renders the task's path-traced references into the store, each whole or not at all.\n"
                      : "# writes its result file whole or not at all.\n")
@@ -152,13 +155,13 @@ std::string array_script(const Sweep& sweep, const SlurmSweepOptions& o, size_t 
       << "#SBATCH --output=" << (sweep.directory() / "logs").string() << "/" << (references ? "references." : "array.")
       << r << "_%a.out\n"
       << "#SBATCH --cpus-per-task=" << o.cpus_per_task << "\n";
-    if (!o.time.empty()) s << "#SBATCH --time=" << slurm_time_minutes(o.time) * o.batch << "\n";
+    if (!o.time.empty()) s << "#SBATCH --time=" << slurm_time_minutes(o.time) * batch << "\n";
     if (!o.mem.empty()) s << "#SBATCH --mem=" << o.mem << "\n";
     common_directives(s, o);
     s << "set -u\n"
       << "tasks=" << quoted(list_file(sweep, round, kind).string()) << "\n"
-      << "first=$(( SLURM_ARRAY_TASK_ID * " << o.batch << " + 1 ))\n"
-      << "last=$(( first + " << o.batch - 1 << " ))\n"
+      << "first=$(( SLURM_ARRAY_TASK_ID * " << batch << " + 1 ))\n"
+      << "last=$(( first + " << batch - 1 << " ))\n"
       << "failed=0\n"
       << "while read -r -a task; do\n"
       << "    echo \"gilab sweep: experiment " << verb << " ${task[*]}\"\n"

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <bit>
 #include <initializer_list>
+#include <map>
 #include <random>
 #include <set>
 #include <string>
@@ -171,41 +172,59 @@ void expect_same_voxels(const Svdag& svdag, const Ssvdag& dag, const std::string
     EXPECT_LE(dag.pointer_count(), svdag.pointer_count()) << what;
 }
 
+// Units of the node at `address` on an interior level: header, short and long pointers.
+uint32_t node_units(const Ssvdag& dag, uint32_t address) {
+    const uint32_t header = dag.units()[address];
+    return 1 + uint32_t(std::popcount(header & 0xffu)) + uint32_t(std::popcount(header >> 8));
+}
+
+// The layout of ssvdag.hpp: every pointer names a node of the level below, it is long
+// exactly when the child lies beyond a short pointer's reach, each level is ordered by
+// references per unit (most first), and the counts and bytes follow from the units.
 void check_storage(const Ssvdag& dag) {
     ASSERT_FALSE(dag.empty());
-    const auto words = dag.words();
-    size_t pointers = 0, mirrored = 0, interior_words = 0;
+    const auto units = dag.units();
+    size_t pointers = 0, mirrored = 0, long_pointers = 0, interior_units = 0, words = 0;
     for (int l = 0; l + 1 < dag.depth(); ++l) {
-        const std::vector<uint32_t> nodes = dag.level_nodes(l);
-        const size_t below = dag.level_node_counts()[l + 1];
-        std::set<uint32_t> below_nodes;
-        if (l + 2 < dag.depth()) {
-            const auto b = dag.level_nodes(l + 1);
-            below_nodes.insert(b.begin(), b.end());
-        }
-        for (uint32_t a : nodes) {
-            ASSERT_LE(words[a], 0xffu) << "the header word holds only the mask";
-            const int k = std::popcount(words[a]);
-            ASSERT_GT(k, 0);
-            for (int i = 0; i < k; ++i) {
-                const SsvdagPointer p = decode_ssvdag_pointer(words[a + 1 + i]);
-                if (l + 2 < dag.depth()) {
-                    ASSERT_TRUE(below_nodes.count(p.address)) << "level " << l;
-                } else {
-                    ASSERT_LT(p.address, below) << "a leaf mask index";
-                }
+        const bool to_leaves = l + 2 == dag.depth();
+        const uint32_t below_begin = to_leaves ? 0 : dag.level_begin(l + 1);
+        std::vector<uint32_t> below_nodes = dag.level_nodes(l + 1);
+        std::map<uint32_t, uint64_t> references;
+        for (uint32_t a : dag.level_nodes(l)) {
+            const uint32_t mask = units[a] & 0xffu, long_mask = units[a] >> 8u;
+            ASSERT_NE(mask, 0u);
+            ASSERT_EQ(long_mask & ~mask, 0u) << "long-pointer bits only on children";
+            for (uint32_t slot = 0; slot < 8; ++slot) {
+                if (!(mask & (1u << slot))) continue;
+                const SsvdagPointer p = dag.stored_child(a, l, slot);
+                ASSERT_TRUE(std::ranges::binary_search(below_nodes, p.address)) << "level " << l;
+                const bool is_long = (long_mask >> slot) & 1u;
+                EXPECT_EQ(is_long, p.address - below_begin >= kSsvdagShortOffsetLimit)
+                    << "level " << l << ": a pointer is short exactly when its child is within reach";
+                ++references[p.address];
                 mirrored += p.mirror != 0;
+                long_pointers += is_long;
+                ++pointers;
             }
-            pointers += k;
-            interior_words += 1 + k;
+            interior_units += node_units(dag, a);
+            words += 1 + std::popcount(mask);
+        }
+        // Every node below is reached, and the level is ordered by references per unit.
+        EXPECT_EQ(references.size(), below_nodes.size()) << "level " << l + 1;
+        for (size_t i = 1; i < below_nodes.size(); ++i) {
+            const uint32_t a = below_nodes[i - 1], b = below_nodes[i];
+            const uint64_t size_a = to_leaves ? 1 : node_units(dag, a), size_b = to_leaves ? 1 : node_units(dag, b);
+            ASSERT_GE(references[a] * size_b, references[b] * size_a) << "level " << l + 1 << ", node " << i;
         }
     }
-    EXPECT_EQ(dag.leaf_begin(), interior_words);
+    EXPECT_EQ(dag.leaf_begin(), interior_units);
     EXPECT_EQ(pointers, dag.pointer_count());
     EXPECT_EQ(mirrored, dag.mirrored_pointer_count());
+    EXPECT_EQ(long_pointers, dag.long_pointer_count());
     const size_t leaves = dag.level_node_counts()[dag.depth() - 1];
     EXPECT_LE(leaves, 45u) << "45 classes of non-empty masks under the 8 reflections";
-    EXPECT_EQ(dag.bytes(), 4 * (interior_words + (leaves + 3) / 4));
+    EXPECT_EQ(dag.bytes(), 2 * (interior_units + (leaves + 1) / 2));
+    EXPECT_EQ(dag.word_bytes(), 4 * (words + (leaves + 3) / 4));
     for (uint32_t i = 0; i < leaves; ++i) EXPECT_NE(dag.leaf_mask(i), 0);
 }
 
@@ -285,12 +304,13 @@ TEST(Ssvdag, MirrorImagesInSiblingOctantsShareOneNode) {
     ASSERT_TRUE(a && b);
     EXPECT_EQ(a->address, b->address);
     EXPECT_EQ(a->mirror ^ b->mirror, 1u) << "the two views differ by the x reflection";
-    // The stored pointer words carry those mirrors in their top 3 bits.
+    // The root's header holds the mask and no long pointers; its two short pointers carry
+    // those mirrors in their top 3 bits.
     const uint32_t root = dag.root().address, rm = dag.root().mirror;
-    ASSERT_EQ(dag.words()[root], uint32_t(reflect_mask(0b11, rm)));
-    const uint32_t first = dag.words()[root + 1], second = dag.words()[root + 2];
-    EXPECT_EQ(first & kSsvdagAddressMask, second & kSsvdagAddressMask);
-    EXPECT_EQ((first ^ second) >> kSsvdagMirrorShift, 1u);
+    ASSERT_EQ(dag.units()[root], uint32_t(reflect_mask(0b11, rm)));
+    const uint32_t first = dag.units()[root + 1], second = dag.units()[root + 2];
+    EXPECT_EQ(first & kSsvdagShortOffsetMask, second & kSsvdagShortOffsetMask);
+    EXPECT_EQ((first ^ second) >> kSsvdagShortMirrorShift, 1u);
     EXPECT_EQ(dag.decode(), codes);
     check_storage(dag);
 }
@@ -347,11 +367,8 @@ TEST(Ssvdag, SymmetricSubtreesGetTheSmallestMirror) {
     const Svdag svdag = Svdag::from_voxels(grid, codes);
     const Ssvdag dag = Ssvdag::from_svdag(svdag);
 
-    const uint32_t root = dag.root().address;
-    const uint8_t stored = dag.stored_mask(root, 0);
     const auto pointer_at = [&](int slot) {
-        const int s = slot ^ int(dag.root().mirror);
-        return decode_ssvdag_pointer(dag.words()[root + 1 + std::popcount(uint32_t(stored) & ((1u << s) - 1))]);
+        return dag.stored_child(dag.root().address, 0, uint32_t(slot) ^ dag.root().mirror);
     };
     // Stored pointers name each subtree by the smallest of its equivalent mirrors.
     EXPECT_EQ(pointer_at(0).mirror, 0u);
@@ -365,7 +382,7 @@ TEST(Ssvdag, SymmetricSubtreesGetTheSmallestMirror) {
     EXPECT_EQ(dag.decode(), codes);
     // Canonical and unique: building again gives the same words and root.
     const Ssvdag again = Ssvdag::from_svdag(svdag);
-    EXPECT_TRUE(std::ranges::equal(again.words(), dag.words()));
+    EXPECT_TRUE(std::ranges::equal(again.units(), dag.units()));
     EXPECT_EQ(again.root(), dag.root());
 }
 
@@ -421,7 +438,7 @@ TEST(Ssvdag, EveryMaskOfADepthOneGrid) {
         ASSERT_EQ(dag.decode(), codes) << "mask " << mask;
         ASSERT_EQ(dag.mask(dag.root(), 0), mask);
         ASSERT_EQ(dag.voxel_count(), codes.size());
-        ASSERT_EQ(dag.bytes(), 4u);
+        ASSERT_EQ(dag.bytes(), 2u) << "one mask byte in one unit";
         for (size_t i = 0; i < rays.size(); i += 7) {
             const VoxelRayHit want = cast_dag_ray(dag_view(svdag), rays[i]), got = cast_ssvdag_ray(dag, rays[i]);
             ASSERT_EQ(got.hit, want.hit) << "mask " << mask << " ray " << i;
@@ -448,6 +465,7 @@ void check_shared_mesh(const std::string& asset, std::initializer_list<uint32_t>
         expect_same_voxels(svdag, dag, what);
         check_storage(dag);
         EXPECT_LT(dag.node_count(), svdag.node_count()) << what;
+        EXPECT_LT(dag.bytes(), dag.word_bytes()) << what << ": short pointers save bytes";
         expect_same_points(svdag, dag, codes, n);
         // The shared rays are set up for the unit cube: move them onto the grid.
         std::vector<Ray> rays = many_rays(n);
@@ -508,6 +526,22 @@ TEST(Ssvdag, RayCastsMatchCastDagRay) {
     expect_same_rays(offset, Ssvdag::from_svdag(offset), rays, "offset 48³ grid");
 }
 
+TEST(Ssvdag, NodesBeyondAShortPointersReachGetLongPointers) {
+    // Random voxels: about 4000 distinct nodes of 9–17 units on the level above the
+    // voxels' parents, far more than a short pointer's 2^13 units reach.
+    std::mt19937 rng(23);
+    const std::vector<uint64_t> codes = gilab::test::random_voxels(rng, 64, 0.3);
+    const Svdag svdag = Svdag::from_voxels(gilab::test::unit_grid(64), codes);
+    const Ssvdag dag = Ssvdag::from_svdag(svdag);
+    ASSERT_GT(dag.level_begin(dag.depth() - 1) - dag.level_begin(dag.depth() - 2), 2 * kSsvdagShortOffsetLimit);
+    EXPECT_GT(dag.long_pointer_count(), 0u);
+    EXPECT_LT(dag.long_pointer_count(), dag.pointer_count()) << "the most referenced nodes stay within reach";
+    check_storage(dag);
+    expect_same_voxels(svdag, dag, "random 64³");
+    expect_same_points(svdag, dag, codes, 5);
+    expect_same_rays(svdag, dag, many_rays(64), "random 64³");
+}
+
 TEST(Ssvdag, NeverMoreNodesAndFewerOnASymmetricScene) {
     for (uint32_t n : {32u, 128u, 256u}) {
         const std::vector<uint64_t> codes = centred_sphere_voxels(n);
@@ -522,7 +556,7 @@ TEST(Ssvdag, NeverMoreNodesAndFewerOnASymmetricScene) {
     }
 }
 
-TEST(Ssvdag, SameWordsWithOneAndTwoThreads) {
+TEST(Ssvdag, SameUnitsWithOneAndTwoThreads) {
     std::mt19937 rng(6);
     const std::vector<uint64_t> codes = gilab::test::random_voxels(rng, 100, 0.05);
     const Svdag svdag = Svdag::from_voxels(gilab::test::unit_grid(100), codes);
@@ -532,7 +566,7 @@ TEST(Ssvdag, SameWordsWithOneAndTwoThreads) {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
         builds.push_back(Ssvdag::from_svdag(svdag));
     }
-    EXPECT_TRUE(std::ranges::equal(builds[0].words(), builds[1].words()));
+    EXPECT_TRUE(std::ranges::equal(builds[0].units(), builds[1].units()));
     EXPECT_EQ(builds[0].root(), builds[1].root());
     EXPECT_EQ(builds[0].level_node_counts(), builds[1].level_node_counts());
     EXPECT_EQ(builds[0].decode(), codes);
@@ -596,6 +630,8 @@ TEST(Ssvdag, StatsReportTheStorage) {
     EXPECT_EQ(s.get("bytes"), double(dag.bytes()));
     EXPECT_EQ(s.get("pointers"), double(dag.pointer_count()));
     EXPECT_EQ(s.get("mirrored_pointers"), double(dag.mirrored_pointer_count()));
+    EXPECT_EQ(s.get("long_pointers"), double(dag.long_pointer_count()));
+    EXPECT_EQ(s.get("word_bytes"), double(dag.word_bytes()));
     EXPECT_EQ(s.get("input_nodes"), double(svdag.node_count()));
     EXPECT_EQ(s.get("nodes_level_0"), 1.0);
     EXPECT_GE(s.get("convert_ms"), s.get("dedup_ms"));

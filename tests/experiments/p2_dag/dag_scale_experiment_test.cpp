@@ -85,9 +85,16 @@ TEST_F(DagScaleTest, TheSsvdagIsNeverLargerAndBitsPerVoxelFollowFromBytes) {
         EXPECT_LE(num(row, "ssvdag_over_svdag"), 1.0) << row.dump();
         EXPECT_NEAR(num(row, "ssvdag_over_svdag"), ssvdag_mb / svdag_mb, 1e-9) << row.dump();
         EXPECT_NEAR(num(row, "ssvdag_over_svdag_nodes"), num(row, "ssvdag_nodes") / num(row, "svdag_nodes"), 1e-9);
-        // Packing the voxels' parents saves bytes; merging under reflections saves more.
+        // Packing the voxels' parents saves bytes, merging under reflections more, short
+        // pointers more again; the ratios follow from the sizes.
+        const double words_mb = num(row, "ssvdag_words_MB");
         EXPECT_LT(packed_mb, svdag_mb) << row.dump();
-        EXPECT_LE(ssvdag_mb, packed_mb) << row.dump();
+        EXPECT_LE(words_mb, packed_mb) << row.dump();
+        EXPECT_LT(ssvdag_mb, words_mb) << row.dump();
+        EXPECT_NEAR(num(row, "ssvdag_words_over_packed_leaves"), words_mb / packed_mb, 1e-9) << row.dump();
+        EXPECT_NEAR(num(row, "ssvdag_over_ssvdag_words"), ssvdag_mb / words_mb, 1e-9) << row.dump();
+        EXPECT_GE(num(row, "long_pointer_share"), 0.0);
+        EXPECT_LT(num(row, "long_pointer_share"), 1.0);
         EXPECT_NEAR(num(row, "bits_per_voxel_svdag"), 8e6 * svdag_mb / voxels, 1e-9 * num(row, "bits_per_voxel_svdag"));
         EXPECT_NEAR(num(row, "bits_per_voxel_ssvdag"), 8e6 * ssvdag_mb / voxels,
                     1e-9 * num(row, "bits_per_voxel_ssvdag"));

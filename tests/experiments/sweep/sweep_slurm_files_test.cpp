@@ -118,6 +118,11 @@ TEST(SweepSlurmFiles, BatchesPutSeveralTasksInOneIndexAndScaleTheTimeLimit) {
     EXPECT_TRUE(contains(array, "#SBATCH --cpus-per-task=4\n")) << array;
     EXPECT_TRUE(contains(array, "--threads 4 experiment run-task")) << array;
     EXPECT_TRUE(contains(array, "first=$(( SLURM_ARRAY_TASK_ID * 3 + 1 ))\nlast=$(( first + 2 ))")) << array;
+    // Reference groups are not batched: one long render per index, its own time limit.
+    const std::string references = read_text(sweep.directory() / "references.1.sbatch");
+    EXPECT_TRUE(contains(references, "#SBATCH --array=0-0\n")) << references;
+    EXPECT_TRUE(contains(references, "#SBATCH --time=10\n")) << references;
+    EXPECT_TRUE(contains(references, "first=$(( SLURM_ARRAY_TASK_ID * 1 + 1 ))\nlast=$(( first + 0 ))")) << references;
 
     // 10 000 tasks in batches of 100: one array of 100 indices.
     std::vector<SweepTask> many(10000, SweepTask{"core-rays", 0});
