@@ -56,7 +56,7 @@ inline constexpr int kSsvdagShortMirrorShift = 13;
 inline constexpr uint32_t kSsvdagShortOffsetLimit = 1u << kSsvdagShortMirrorShift;  // offsets below this
 inline constexpr uint32_t kSsvdagShortOffsetMask = kSsvdagShortOffsetLimit - 1;
 
-// A reference to a stored node: its address (word address, or mask index on level
+// A reference to a stored node: its address (unit address, or mask index on level
 // depth-1) and the reflection under which it is seen.
 struct SsvdagPointer {
     uint32_t address = 0;
@@ -134,9 +134,6 @@ public:
         const uint32_t unit = units_[at];
         return {(unit & kSsvdagShortOffsetMask) + child_level_begin_[size_t(level)], unit >> kSsvdagShortMirrorShift};
     }
-    // Where the level below each interior level starts (0 for level depth-1, addressed by
-    // index): what a short pointer's offset is added to.
-    const uint32_t* child_level_begins() const { return child_level_begin_.data(); }
     // Child mask of a node as seen through its pointer's mirror.
     uint8_t mask(const SsvdagPointer& node, int level) const {
         return reflect_mask(stored_mask(node.address, level), node.mirror);
@@ -179,7 +176,7 @@ private:
     uint32_t leaf_begin_ = 0;
     std::vector<uint64_t> level_counts_;
     std::vector<uint64_t> level_begin_;          // unit where each interior level starts, then leaf_begin_
-    std::vector<uint32_t> child_level_begin_;    // per interior level: where the level below starts
+    std::vector<uint32_t> child_level_begin_;    // per interior level: where the level below starts (0 above the masks)
     size_t pointer_count_ = 0;
     size_t mirrored_pointer_count_ = 0;
     size_t long_pointer_count_ = 0;

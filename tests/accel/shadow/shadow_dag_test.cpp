@@ -1,8 +1,10 @@
 // Shadow DAG over light space (P2 §3): merge rules, SVO ↔ DAG, tiling, double depth
 // maps, and lookups against Embree shadow rays.
 #include <gtest/gtest.h>
+#include <array>
 #include <cmath>
 #include <functional>
+#include <map>
 #include <random>
 #include <vector>
 #include "accel/dag/dag_layout.hpp"
@@ -214,12 +216,17 @@ TEST(ShadowDag, DoubleDepthAgreesOutsideClosedGeometryAndIsSmaller) {
 namespace {
 
 // What the paper's tree holds for a voxel: the state of the first cell on its path that
-// the rules do not subdivide (at the 4³ leaves, the voxel's own state).
-ShadowState folded_state(const Maps& m, const UVec3& v, uint32_t grid) {
+// the rules do not subdivide (at the 4³ leaves, the voxel's own state). `cells` keeps
+// each cell's state (by size and first voxel), so that a whole grid costs one pass of the
+// rules per level rather than one per voxel.
+using CellStates = std::map<std::array<uint32_t, 4>, ShadowState>;
+ShadowState folded_state(const Maps& m, const UVec3& v, uint32_t grid, CellStates& cells) {
     for (uint32_t size = grid; size >= 4; size /= 2) {
         const UVec3 first = v / size * size;
-        const ShadowState s = reference_state(m, first, size);
-        if (s != S::Boundary) return s;
+        const std::array<uint32_t, 4> key{size, first.x, first.y, first.z};
+        auto cell = cells.find(key);
+        if (cell == cells.end()) cell = cells.emplace(key, reference_state(m, first, size)).first;
+        if (cell->second != S::Boundary) return cell->second;
     }
     return m.voxel(v.x, v.y, v.z);
 }
@@ -251,12 +258,13 @@ TEST(ShadowDag, UndefinedSpaceLeftByTheRulesAnswersShadow) {
     const ShadowDag lit = dag_from_maps(m, 5, 32, S::Lit);
     EXPECT_EQ(ShadowDagOptions{}.undefined_as, S::Shadow);
     size_t undefined = 0;
+    CellStates cells;
     for (uint32_t z = 0; z < 32; ++z)
         for (uint32_t y = 0; y < 32; ++y)
             for (uint32_t x = 0; x < 32; ++x) {
                 const UVec3 v(x, y, z);
                 const DVec3 centre(x + 0.5, y + 0.5, z + 0.5);
-                const S want = folded_state(m, v, 32);
+                const S want = folded_state(m, v, 32, cells);
                 if (want != S::Undefined) {
                     ASSERT_EQ(shadow.lit_at(centre), want == S::Lit) << x << "," << y << "," << z;
                     continue;
