@@ -5,105 +5,16 @@
 #include <tbb/parallel_for.h>
 #include "accel/dag/child_mask.hpp"
 #include "accel/dag/dag_level_table.hpp"
+#include "accel/dag/symmetric_merge.hpp"
 #include "core/util/error.hpp"
 #include "core/util/morton.hpp"
 
 namespace gilab {
 namespace {
 
-// Of the mirrors x ^ r, r a reflection that leaves the node unchanged (bit r of
-// `symmetries`), the smallest: every view of a symmetric subtree then has one name, which
-// makes keys, and so merging, independent of how the subtree was reached.
-constexpr std::array<std::array<uint8_t, 8>, 256> make_reduced_mirrors() {
-    std::array<std::array<uint8_t, 8>, 256> t{};
-    for (uint32_t symmetries = 0; symmetries < 256; ++symmetries)
-        for (uint32_t x = 0; x < 8; ++x) {
-            uint32_t best = x;
-            for (uint32_t r = 0; r < 8; ++r)
-                if (symmetries & (1u << r)) best = std::min(best, x ^ r);
-            t[symmetries][x] = uint8_t(best);
-        }
-    return t;
-}
-constexpr auto kReducedMirrors = make_reduced_mirrors();
-
-// A child while building: its id on its level and its mirror, id << 3 | mirror, so
-// comparing refs compares (id, mirror).
-inline uint32_t child_ref(uint32_t id, uint32_t mirror) { return id << 3 | mirror; }
-inline uint32_t ref_id(uint32_t ref) { return ref >> 3; }
-inline uint32_t ref_mirror(uint32_t ref) { return ref & 7u; }
-
-// A node in canonical form: the smallest of its 8 reflected keys.
-struct CanonicalNode {
-    uint8_t mask = 0;        // of the stored node
-    uint8_t mirror = 0;      // the smallest reflection turning the stored node into the given one
-    uint8_t symmetries = 0;  // bit r: reflecting the stored node by r leaves it unchanged
-    uint8_t count = 0;
-    uint32_t children[8] = {};  // refs of the stored node's children, in slot order
-    uint64_t hash = 0;
-};
-
-// Key order: the mask, then the child refs in slot order (equal masks, equal counts).
-inline int compare_keys(uint8_t mask_a, const uint32_t* a, uint8_t mask_b, const uint32_t* b, uint32_t count) {
-    if (mask_a != mask_b) return mask_a < mask_b ? -1 : 1;
-    for (uint32_t i = 0; i < count; ++i)
-        if (a[i] != b[i]) return a[i] < b[i] ? -1 : 1;
-    return 0;
-}
-
-// `slot_refs[k]` is the ref of the child in slot k of the node as given;
-// `child_symmetries` the symmetries of the level below, by id. Nodes of level depth-1
-// have no children to key (their children are voxels, alike under every reflection).
-void canonicalize(uint8_t mask, const uint32_t* slot_refs, const uint8_t* child_symmetries, bool has_children,
-                  CanonicalNode& out) {
-    const uint32_t count = has_children ? child_count(mask) : 0;
-    uint32_t key[8];
-    uint32_t ties = 0;  // bit m: reflection m gives the best key
-    for (uint32_t m = 0; m < 8; ++m) {
-        const uint8_t reflected = reflect_mask(mask, m);
-        uint32_t n = 0;
-        if (has_children)
-            for (uint32_t j = 0; j < 8; ++j) {
-                if (!(reflected & (1u << j))) continue;
-                const uint32_t r = slot_refs[j ^ m];
-                key[n++] = child_ref(ref_id(r), kReducedMirrors[child_symmetries[ref_id(r)]][ref_mirror(r) ^ m]);
-            }
-        const int order = m == 0 ? -1 : compare_keys(reflected, key, out.mask, out.children, count);
-        if (order < 0) {
-            out.mask = reflected;
-            std::copy(key, key + n, out.children);
-            out.mirror = uint8_t(m);
-            ties = 1u << m;
-        } else if (order == 0) {
-            ties |= 1u << m;
-        }
-    }
-    // Reflections are their own inverses, so the given node is the stored one reflected by
-    // out.mirror, and the stored one is unchanged exactly by m ^ out.mirror for tied m.
-    out.symmetries = 0;
-    for (uint32_t m = 0; m < 8; ++m)
-        if (ties & (1u << m)) out.symmetries |= uint8_t(1u << (m ^ out.mirror));
-    out.count = uint8_t(count);
-    out.hash = DagLevelTable::hash(out.mask, out.children, count);
-}
-
-// One SVDAG level converted: the ref of each of its nodes (by word address from the
-// level's first word) and the symmetries of each stored node (by id).
-struct ConvertedLevel {
-    uint32_t first_word = 0;
-    std::vector<uint32_t> ref_at;
-    std::vector<uint8_t> symmetries;
-
-    uint32_t ref(uint32_t svdag_address) const { return ref_at[svdag_address - first_word]; }
-};
-
-ConvertedLevel level_frame(const Svdag& dag, const std::vector<uint32_t>& nodes) {
-    ConvertedLevel c;
-    if (nodes.empty()) return c;
-    c.first_word = nodes.front();
-    c.ref_at.assign(nodes.back() + 1 + child_count(dag.mask(nodes.back())) - c.first_word, 0);
-    return c;
-}
+using Merge = SymmetricMerge<ReflectionGroup>;
+inline uint32_t ref_id(uint32_t ref) { return Merge::ref_id(ref); }
+inline uint32_t ref_mirror(uint32_t ref) { return Merge::ref_transform(ref); }
 
 }  // namespace
 
@@ -114,7 +25,7 @@ uint32_t encode_ssvdag_pointer(uint64_t address, uint32_t mirror) {
     return mirror << kSsvdagMirrorShift | uint32_t(address);
 }
 
-// The level-by-level conversion and the layout into units.
+// The layout of the merged levels into units.
 class SsvdagBuilder {
 public:
     explicit SsvdagBuilder(const Svdag& dag) : dag_(dag), depth_(dag.depth()) {}
@@ -125,97 +36,28 @@ public:
         out.grid_ = dag_.grid();
         out.depth_ = depth_;
         out.level_counts_.assign(depth_ + 1, 0);
+        double dedup_ms = 0;
         if (!dag_.empty()) {
             out.empty_ = false;
             out.level_counts_[depth_] = 1;
             if (depth_ > 0) {
-                tables_.resize(depth_ - 1);
-                ConvertedLevel below = convert_leaf_parents();
-                for (int l = depth_ - 2; l >= 0; --l) below = convert_level(l, below);
-                const uint32_t root_ref = below.ref(dag_.root());
-                out.stats_.table_bytes = table_bytes();
-                lay_out(out, root_ref);
+                const Merge merge(dag_);
+                dedup_ms = merge.dedup_ms();
+                out.stats_.table_bytes = merge.table_bytes();
+                lay_out(out, merge);
             }
         }
         out.stats_.input_nodes = dag_.node_count();
-        out.stats_.dedup_ms = dedup_ms_;
+        out.stats_.dedup_ms = dedup_ms;
         out.stats_.total_ms = clock.elapsed_ms();
         return out;
     }
 
 private:
-    // Level depth-1: a node is its mask alone, so at most 46 masks survive the reflections.
-    ConvertedLevel convert_leaf_parents() {
-        Stopwatch t;
-        const std::vector<uint32_t> nodes = dag_.level_nodes(depth_ - 1);
-        ConvertedLevel c = level_frame(dag_, nodes);
-        std::array<uint32_t, 256> id_of;
-        id_of.fill(kInvalidNode);
-        for (uint32_t a : nodes) {
-            CanonicalNode n;
-            canonicalize(dag_.mask(a), nullptr, nullptr, false, n);
-            uint32_t& id = id_of[n.mask];
-            if (id == kInvalidNode) {
-                id = uint32_t(leaf_masks_.size());
-                leaf_masks_.push_back(n.mask);
-                c.symmetries.push_back(n.symmetries);
-            }
-            c.ref_at[a - c.first_word] = child_ref(id, n.mirror);
-        }
-        dedup_ms_ += t.elapsed_ms();
-        return c;
-    }
-
-    ConvertedLevel convert_level(int level, const ConvertedLevel& below) {
-        Stopwatch t;
-        const std::vector<uint32_t> nodes = dag_.level_nodes(level);
-        ConvertedLevel c = level_frame(dag_, nodes);
-        const std::span<const uint32_t> words = dag_.words();
-        DagLevelTable& table = tables_[level];
-        // Keys are made in parallel a chunk at a time (bounded memory), then looked up in
-        // order so that ids, and so the words, do not depend on the thread count.
-        constexpr size_t kChunk = size_t(1) << 16;
-        std::vector<CanonicalNode> keyed(std::min(nodes.size(), kChunk));
-        for (size_t begin = 0; begin < nodes.size(); begin += kChunk) {
-            const size_t end = std::min(nodes.size(), begin + kChunk);
-            tbb::parallel_for(tbb::blocked_range<size_t>(begin, end, 1024), [&](const tbb::blocked_range<size_t>& r) {
-                for (size_t j = r.begin(); j < r.end(); ++j) {
-                    const uint32_t a = nodes[j];
-                    const uint32_t mask = words[a] & 0xffu;
-                    uint32_t slot_refs[8];
-                    for (uint32_t s = 0, i = 0; s < 8; ++s)
-                        if (mask & (1u << s)) slot_refs[s] = below.ref(words[a + 1 + i++]);
-                    canonicalize(uint8_t(mask), slot_refs, below.symmetries.data(), true, keyed[j - begin]);
-                }
-            });
-            constexpr size_t kAhead = 16;  // prefetch distance: lookups miss the cache
-            for (size_t j = begin; j < end; ++j) {
-                if (j + kAhead < end) table.prefetch(keyed[j + kAhead - begin].hash);
-                const CanonicalNode& n = keyed[j - begin];
-                const size_t before = table.size();
-                const uint32_t id = table.find_or_insert(n.mask, n.children, n.count, n.hash);
-                if (table.size() != before) {
-                    if (id >= kSsvdagAddressLimit)
-                        throw Error("SSVDAG", "level " + std::to_string(level) + " holds more than 2^29 nodes");
-                    c.symmetries.push_back(n.symmetries);
-                }
-                c.ref_at[nodes[j] - c.first_word] = child_ref(id, n.mirror);
-            }
-        }
-        dedup_ms_ += t.elapsed_ms();
-        return c;
-    }
-
-    size_t table_bytes() const {
-        size_t b = leaf_masks_.capacity();
-        for (const auto& t : tables_) b += t.memory_bytes();
-        return b;
-    }
-
     // How many pointers of level `level` reach each node of level `level` + 1, by id.
-    std::vector<uint32_t> references_to_level_below(int level, size_t below_count) const {
+    static std::vector<uint32_t> references_to_level_below(const Merge& merge, int level, size_t below_count) {
         std::vector<uint32_t> refs(below_count, 0);
-        const DagLevelTable& t = tables_[size_t(level)];
+        const DagLevelTable& t = merge.tables()[size_t(level)];
         for (uint32_t u = 0; u < t.size(); ++u)
             for (uint32_t ref : t.children(u)) ++refs[ref_id(ref)];
         return refs;
@@ -243,20 +85,23 @@ private:
 
     // Levels ordered bottom-up (a node's size depends on which of its children sit within
     // a short pointer's reach), then laid out top-down, then the leaf masks.
-    void lay_out(Ssvdag& out, uint32_t root_ref) {
+    void lay_out(Ssvdag& out, const Merge& merge) {
+        const std::vector<DagLevelTable>& tables = merge.tables();  // levels 0..depth-2
+        const std::vector<uint8_t>& leaf_masks = merge.leaf_masks();  // level depth-1, by id
+        const uint32_t root_ref = merge.root_ref();
         const int interior = depth_ - 1;  // levels stored as header + pointers
         // offset[l][id]: from level l's start, in units (mask index on level depth-1).
         std::vector<std::vector<uint32_t>> offset(static_cast<size_t>(depth_));
         std::vector<uint64_t> level_units(size_t(interior), 0);
         uint64_t leaf_total = 0;
         {
-            const std::vector<uint32_t> refs = depth_ == 1 ? std::vector<uint32_t>(leaf_masks_.size(), 1)
-                                                            : references_to_level_below(interior - 1, leaf_masks_.size());
-            offset[size_t(interior)] = order_by_references(refs, std::vector<uint8_t>(leaf_masks_.size(), 1), leaf_total);
+            const std::vector<uint32_t> refs = depth_ == 1 ? std::vector<uint32_t>(leaf_masks.size(), 1)
+                                                            : references_to_level_below(merge, interior - 1, leaf_masks.size());
+            offset[size_t(interior)] = order_by_references(refs, std::vector<uint8_t>(leaf_masks.size(), 1), leaf_total);
         }
         const auto is_short = [](uint32_t child_offset) { return child_offset < kSsvdagShortOffsetLimit; };
         for (int l = interior - 1; l >= 0; --l) {
-            const DagLevelTable& t = tables_[size_t(l)];
+            const DagLevelTable& t = tables[size_t(l)];
             std::vector<uint8_t> units(t.size());
             for (uint32_t u = 0; u < t.size(); ++u) {
                 uint32_t n = 1;
@@ -264,7 +109,7 @@ private:
                 units[u] = uint8_t(n);
             }
             const std::vector<uint32_t> refs =
-                l == 0 ? std::vector<uint32_t>(t.size(), 1) : references_to_level_below(l - 1, t.size());
+                l == 0 ? std::vector<uint32_t>(t.size(), 1) : references_to_level_below(merge, l - 1, t.size());
             offset[size_t(l)] = order_by_references(refs, units, level_units[size_t(l)]);
         }
 
@@ -272,14 +117,14 @@ private:
         uint64_t next = 0;
         for (int l = 0; l < interior; ++l) {
             out.level_begin_[size_t(l)] = next;
-            out.level_counts_[size_t(l)] = tables_[size_t(l)].size();
-            out.pointer_count_ += tables_[size_t(l)].child_count_total();
-            out.word_bytes_ += 4 * (tables_[size_t(l)].size() + tables_[size_t(l)].child_count_total());
+            out.level_counts_[size_t(l)] = tables[size_t(l)].size();
+            out.pointer_count_ += tables[size_t(l)].child_count_total();
+            out.word_bytes_ += 4 * (tables[size_t(l)].size() + tables[size_t(l)].child_count_total());
             next += level_units[size_t(l)];
         }
         out.level_begin_[size_t(interior)] = next;
-        out.level_counts_[size_t(depth_ - 1)] = leaf_masks_.size();
-        out.word_bytes_ += 4 * ((leaf_masks_.size() + 3) / 4);
+        out.level_counts_[size_t(depth_ - 1)] = leaf_masks.size();
+        out.word_bytes_ += 4 * ((leaf_masks.size() + 3) / 4);
         // Every interior address must fit a long pointer; checked before allocating the units.
         if (next > kSsvdagAddressLimit)
             throw Error("SSVDAG", "the DAG needs " + std::to_string(next) +
@@ -287,14 +132,14 @@ private:
         out.child_level_begin_.assign(size_t(std::max(interior, 0)), 0);
         for (int l = 0; l + 1 < interior; ++l) out.child_level_begin_[size_t(l)] = uint32_t(out.level_begin_[size_t(l + 1)]);
         out.leaf_begin_ = uint32_t(next);
-        out.units_.assign(next + (leaf_masks_.size() + 1) / 2, 0);
-        for (size_t id = 0; id < leaf_masks_.size(); ++id) {
+        out.units_.assign(next + (leaf_masks.size() + 1) / 2, 0);
+        for (size_t id = 0; id < leaf_masks.size(); ++id) {
             const uint32_t index = offset[size_t(interior)][id];
-            out.units_[next + index / 2] |= uint16_t(uint32_t(leaf_masks_[id]) << (8 * (index % 2)));
+            out.units_[next + index / 2] |= uint16_t(uint32_t(leaf_masks[id]) << (8 * (index % 2)));
         }
 
         for (int l = 0; l < interior; ++l) {
-            const DagLevelTable& t = tables_[size_t(l)];
+            const DagLevelTable& t = tables[size_t(l)];
             const std::vector<uint32_t>& below = offset[size_t(l + 1)];
             const uint32_t below_begin = out.child_level_begin_[size_t(l)];
             const uint64_t begin = out.level_begin_[size_t(l)];
@@ -333,9 +178,6 @@ private:
 
     const Svdag& dag_;
     int depth_;
-    std::vector<DagLevelTable> tables_;  // levels 0..depth-2
-    std::vector<uint8_t> leaf_masks_;    // level depth-1, by id
-    double dedup_ms_ = 0;
 };
 
 Ssvdag Ssvdag::from_svdag(const Svdag& dag) { return SsvdagBuilder(dag).build(); }

@@ -6,12 +6,8 @@
 // m moves the child of slot k to slot k ^ m and reflects each child subtree by m too, so
 // a child (node, c) of a node seen through mirror m is (node, c ^ m).
 //
-// Built from an Svdag bottom-up, level by level from the voxels' parents: each node is
-// keyed as (mask, then (child id, child mirror) per non-empty slot in slot order) under
-// all 8 reflections; the smallest key is stored and the node is referred to as that key
-// plus the smallest mirror that gives it. Child mirrors are reduced by the child's own
-// symmetries before keying, so a symmetric subtree has one key and the result is the
-// unique minimal SSVDAG over reflections: the same for every build and thread count.
+// Built from an Svdag by merging its subtrees under the reflections (symmetric_merge.hpp):
+// the unique minimal SSVDAG over reflections, the same for every build and thread count.
 //
 // Implemented from the paper: merging under the 8 reflections along the grid axes, the
 // mirror carried in each pointer, variable-size pointers (16 bits to the nodes that most
@@ -40,6 +36,7 @@
 #include <span>
 #include <vector>
 #include "accel/dag/child_mask.hpp"
+#include "accel/dag/node_symmetry.hpp"
 #include "accel/dag/svdag.hpp"
 #include "core/util/math.hpp"
 #include "core/util/stats.hpp"
@@ -71,24 +68,10 @@ inline SsvdagPointer decode_ssvdag_pointer(uint32_t word) {
     return {word & kSsvdagAddressMask, word >> kSsvdagMirrorShift};
 }
 
-namespace detail {
-constexpr std::array<std::array<uint8_t, 256>, 8> make_reflected_masks() {
-    std::array<std::array<uint8_t, 256>, 8> t{};
-    for (uint32_t m = 0; m < 8; ++m)
-        for (uint32_t mask = 0; mask < 256; ++mask) {
-            uint32_t r = 0;
-            for (uint32_t k = 0; k < 8; ++k)
-                if (mask & (1u << k)) r |= 1u << (k ^ m);
-            t[m][mask] = uint8_t(r);
-        }
-    return t;
-}
-inline constexpr std::array<std::array<uint8_t, 256>, 8> kReflectedMasks = make_reflected_masks();
-}  // namespace detail
 
 // The child mask of a node reflected by `mirror`: bit k moves to bit k ^ mirror.
 inline uint8_t reflect_mask(uint32_t mask, uint32_t mirror) {
-    return detail::kReflectedMasks[mirror & 7u][mask & 0xffu];
+    return ReflectionGroup::transform_mask(mirror, mask);
 }
 
 struct SsvdagBuildStats {

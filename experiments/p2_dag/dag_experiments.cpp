@@ -639,7 +639,8 @@ ExperimentOutput reduce_fig13(const SpecReduction& r) {
 
 }  // namespace
 
-Experiment dag_scale_experiment();  // dag-scale, dag_scale_experiment.cpp
+Experiment dag_scale_experiment();     // dag-scale, dag_scale_experiment.cpp
+Experiment dag_symmetry_experiment();  // dag-symmetries, dag_symmetry_experiment.cpp
 
 void register_dag_experiments(ExperimentRegistry& registry) {
     add_probe("dag-structures", model_probe(measure_structures));
@@ -773,6 +774,7 @@ void register_dag_experiments(ExperimentRegistry& registry) {
                   "paper curve."},
     }));
     registry.add(dag_scale_experiment());
+    registry.add(dag_symmetry_experiment());
 }
 
 }  // namespace gilab

@@ -18,6 +18,7 @@
 #include "core/util/stats.hpp"
 #include "core/voxel/voxelizer.hpp"
 #include "experiments/p2_dag/dag_models.hpp"
+#include "experiments/p2_dag/streamed_svdag_row.hpp"
 #include "experiments/runner/experiment.hpp"
 #include "experiments/runner/measures.hpp"
 #include "experiments/runner/spec_functions.hpp"
@@ -29,13 +30,6 @@ namespace {
 using nlohmann::json;
 using namespace p2;
 
-// dag-table3's split rule: subtrees of at most 2^8 = 256 voxels per axis.
-constexpr int kSubtreeLog2 = 8;
-
-// Rows are attempted up to this many voxels by the voxelizer's estimate (above the true
-// count): over an hour of voxelizing on a two-core machine at the 17 million voxels a
-// second per thread measured on Sponza. Memory is watched while the row builds.
-constexpr uint64_t kMaxRowEstimatedVoxels = uint64_t(1) << 37;
 // While the streamed build runs, the cells being voxelized (two batches of one cell per
 // thread, 8 B per voxel) sit beside its merge tables; the tables get the rest of the
 // row's budget and the build stops with a note past it. After the build, the SSVDAG
@@ -46,17 +40,6 @@ constexpr double kAfterBuildOverDag = 5;
 // list grows): only up to this many voxels, and only within the row's memory budget.
 constexpr uint64_t kDecodeVoxelLimit = uint64_t(1) << 26;
 constexpr uint64_t kDecodeBytesPerVoxel = 32;
-// A long build reports how far it got at most this often.
-constexpr double kProgressEverySeconds = 60;
-
-uint64_t cells_in_flight_bytes(const Voxelizer& voxelizer, int split_level, int threads) {
-    const VoxelGrid& grid = voxelizer.grid();
-    const uint64_t voxels = voxelizer.estimate_voxels(grid.full_region());
-    const int cell_log2 = grid.depth() - split_level;
-    const uint64_t cell_volume = uint64_t(1) << (3 * std::min(cell_log2, 20));
-    return 8 * std::min(voxels, 2 * cell_volume * uint64_t(threads));
-}
-
 // The SVDAG's bytes with its level depth-1 nodes (the voxels' parents) stored as the
 // SSVDAG's 32-bit layout stores them: their 8-bit masks, four to a word, in place of a
 // mask word plus one pointer per voxel each, and no word for the voxel node. Pointers to
@@ -179,64 +162,37 @@ void measure_scale(const ProbeCall& call, const Model& model, ProbeOutput& out) 
     const auto single_thread_up_to = call.setting<uint32_t>("single_thread_up_to");
     const int ray_reps = call.setting<int>("ray_repetitions");
     const ExperimentContext& ctx = call.ctx;
-    const std::string row_name = model.label + " " + cube(res);
-    if (res > kMaxVoxelResolution) {
-        out.notes.push_back(row_name + " skipped: the grid holds at most " + cube(kMaxVoxelResolution) + " voxels");
-        return;
-    }
-    const Voxelizer voxelizer(model.positions, model.triangles, model_grid(model, res));
-    const int split_level = std::max(0, voxelizer.grid().depth() - kSubtreeLog2);
-    const size_t budget = available_memory_bytes() / 2;
     const int threads = ctx.threads > 0 ? ctx.threads : default_thread_count();
+    const StreamedSvdagRow row(model, res, threads);
+    const std::string& row_name = row.name();
     auto skip = [&](const std::string& why) {
         out.notes.push_back(row_name + " skipped: " + why);
         ctx.say(row_name + ": skipped, " + why);
     };
-    const uint64_t estimated_voxels = voxelizer.estimate_voxels(voxelizer.grid().full_region());
-    if (estimated_voxels > kMaxRowEstimatedVoxels) {
-        skip("about " + std::to_string(estimated_voxels) +
-             " voxels by the voxelizer's estimate, more than the 2³⁷ a row voxelizes");
+    if (!row.refusal().empty()) {
+        skip(row.refusal());
         return;
     }
-    const uint64_t in_flight = cells_in_flight_bytes(voxelizer, split_level, threads);
-    if (in_flight >= budget) {
-        skip(budget_text(in_flight, budget) + " for the cells being voxelized");
-        return;
-    }
-    SvdagStreamOptions stream;
-    stream.max_table_bytes = budget - in_flight;
-    Stopwatch progress_watch;
-    double last_progress_s = 0;
-    stream.progress = [&](size_t done, size_t cells) {
-        const double now = seconds_of(progress_watch);
-        if (done == cells || now - last_progress_s < kProgressEverySeconds) return;
-        last_progress_s = now;
-        ctx.say(row_name + ": " + std::to_string(done * 100 / cells) + " % of " + std::to_string(cells) +
-                " cells merged, " + std::to_string(int(now)) + " s");
-    };
+    const size_t budget = row.budget_bytes();
+    const uint64_t in_flight = row.in_flight_bytes();
+    const int split_level = row.split_level();
+    const auto say = [&](const std::string& s) { ctx.say(s); };
     const double load_before = load_average();
     if (!reset_peak_rss())
         out.notes.push_back("VmHWM could not be reset on this system: peak_rss_MiB is process-wide.");
     const size_t rss_before = current_rss_bytes();
-    const std::string build_text = split_level > 0 ? "split build at level " + std::to_string(split_level) +
-                                                         " (" + cube(1u << kSubtreeLog2) + " subtrees)"
-                                                   : "whole build";
     try {
         json single_thread_s = nullptr;
         if (res <= single_thread_up_to) {
-            ctx.say(row_name + ": SVDAG, " + build_text + ", 1 thread");
+            ctx.say(row_name + ": SVDAG, " + row.build_text() + ", 1 thread");
             ThreadLimit one(1);
             Stopwatch watch;
-            progress_watch = Stopwatch();
-            last_progress_s = 0;
-            Svdag::from_voxelizer(voxelizer, split_level, stream);
+            row.build(say);
             single_thread_s = seconds_of(watch);
         }
-        ctx.say(row_name + ": SVDAG, " + build_text + ", all threads");
+        ctx.say(row_name + ": SVDAG, " + row.build_text() + ", all threads");
         Stopwatch build_watch;
-        progress_watch = Stopwatch();
-        last_progress_s = 0;
-        const Svdag svdag = Svdag::from_voxelizer(voxelizer, split_level, stream);
+        const Svdag svdag = row.build(say);
         const double build_s = seconds_of(build_watch);
         const uint64_t voxels = svdag.build_stats().input_nodes;
         const uint64_t need = uint64_t(kAfterBuildOverDag * double(svdag.bytes()));
