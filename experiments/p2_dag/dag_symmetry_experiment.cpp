@@ -173,7 +173,7 @@ Experiment dag_symmetry_experiment() {
                        "32-bit word layout, and how many pointers need a permutation",
         .scenes = scenes,
         .variants = {{.name = "reflections, cube symmetries", .probe = "dag-symmetries", .settings = json::object()}},
-        .axes = {{"resolution", {2048, 4096, 8192, 16384}, {64, 128}}},
+        .axes = {{"resolution", {2048, 4096, 8192}, {64, 128}}},
         .reducer = "dag-symmetries",
         .notes = {
             "Models, grids and the SVDAG build are dag-scale's (streamed split build, 256³ subtrees, all threads, "
