@@ -9,7 +9,8 @@
 //   DagWalkNode root() const;
 //   uint32_t mask(DagWalkNode node, bool voxel_parent) const;   // 8-bit child mask
 //   DagWalkNode child(DagWalkNode node, uint32_t mask, uint32_t stored_slot, int level) const;
-// voxel_parent: the node's children are voxels; level: the node's, 0 at the root. A node may be stored reflected (SSVDAG):
+// voxel_parent: the node's children are voxels; level: the node's, 0 at the root. A node
+// may be stored reflected (SSVDAG):
 // `child` returns the pointer's own mirror, and the walk composes the mirrors along the
 // path, so the cell in slot k of a node seen through mirror m is its stored slot k ^ m.
 // Formats without mirrors return 0, which the compiler folds away.

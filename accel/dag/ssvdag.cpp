@@ -93,11 +93,13 @@ private:
         // offset[l][id]: from level l's start, in units (mask index on level depth-1).
         std::vector<std::vector<uint32_t>> offset(static_cast<size_t>(depth_));
         std::vector<uint64_t> level_units(size_t(interior), 0);
-        uint64_t leaf_total = 0;
         {
-            const std::vector<uint32_t> refs = depth_ == 1 ? std::vector<uint32_t>(leaf_masks.size(), 1)
-                                                            : references_to_level_below(merge, interior - 1, leaf_masks.size());
-            offset[size_t(interior)] = order_by_references(refs, std::vector<uint8_t>(leaf_masks.size(), 1), leaf_total);
+            const std::vector<uint32_t> refs = depth_ == 1
+                                                   ? std::vector<uint32_t>(leaf_masks.size(), 1)
+                                                   : references_to_level_below(merge, interior - 1, leaf_masks.size());
+            uint64_t masks_total = 0;  // one per mask: the level's size is known already
+            offset[size_t(interior)] =
+                order_by_references(refs, std::vector<uint8_t>(leaf_masks.size(), 1), masks_total);
         }
         const auto is_short = [](uint32_t child_offset) { return child_offset < kSsvdagShortOffsetLimit; };
         for (int l = interior - 1; l >= 0; --l) {

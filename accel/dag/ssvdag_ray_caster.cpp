@@ -11,12 +11,9 @@ namespace {
 // voxels' parents as bytes, two to a unit, named by index.
 struct MirroredNodes {
     const Ssvdag& dag;
-    const uint16_t* units;
-    uint32_t leaf_begin;
     DagWalkNode root() const { return {dag.root().address, dag.root().mirror}; }
     uint32_t mask(DagWalkNode node, bool voxel_parent) const {
-        if (voxel_parent) return (units[leaf_begin + (node.address >> 1)] >> (8 * (node.address & 1u))) & 0xffu;
-        return units[node.address] & 0xffu;
+        return voxel_parent ? dag.leaf_mask(node.address) : uint32_t(dag.units()[node.address] & 0xffu);
     }
     DagWalkNode child(DagWalkNode node, uint32_t, uint32_t slot, int level) const {
         const SsvdagPointer p = dag.stored_child(node.address, level, slot);
@@ -28,7 +25,7 @@ struct MirroredNodes {
 
 VoxelRayHit cast_ssvdag_ray(const Ssvdag& dag, const Ray& ray) {
     if (dag.empty()) return {};
-    const MirroredNodes nodes{dag, dag.units().data(), dag.leaf_begin()};
+    const MirroredNodes nodes{dag};
     return walk_dag_ray(nodes, dag.grid(), dag.depth(), ray);
 }
 

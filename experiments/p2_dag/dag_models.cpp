@@ -2,6 +2,7 @@
 
 #include <fstream>
 #include "core/util/error.hpp"
+#include "experiments/runner/measures.hpp"
 #include "scenes/scene_library.hpp"
 
 namespace gilab::p2 {
@@ -34,6 +35,12 @@ std::vector<std::string> paper_model_scenes() {
     std::vector<std::string> scenes;
     for (const ModelSpec& m : model_specs())
         if (!m.paper.empty()) scenes.push_back(m.scene);
+    return scenes;
+}
+
+std::vector<std::string> model_scenes() {
+    std::vector<std::string> scenes;
+    for (const ModelSpec& m : model_specs()) scenes.push_back(m.scene);
     return scenes;
 }
 
@@ -123,6 +130,33 @@ std::optional<std::string> load_note(const std::vector<json>& rows) {
     if (rows.empty() || !rows.front().contains("load_average_before")) return std::nullopt;
     return "Load average (1 min) at the start of the first timed row: " + rows.front()["load_average_before"].dump() +
            "; at the end of the last: " + rows.back()["load_average_after"].dump() + ".";
+}
+
+ResultTable resolution_means(const std::vector<json>& rows, const std::vector<json>& resolutions,
+                             const std::vector<std::string>& columns) {
+    ResultTable t;
+    t.title = "Mean over the rows present, per resolution and over all rows";
+    t.columns = {"resolution", "rows"};
+    for (const std::string& c : columns) t.columns.push_back("mean_" + c);
+    auto summarize = [&](const json& resolution) {
+        auto values = [&](const std::string& column) {
+            std::vector<double> v;
+            for (const json& row : rows)
+                if ((resolution == "all" || row.at("resolution") == resolution) && row.contains(column) &&
+                    row.at(column).is_number())
+                    v.push_back(row.at(column).get<double>());
+            return v;
+        };
+        json out = {{"resolution", resolution}, {"rows", values(columns.at(0)).size()}};
+        for (const std::string& c : columns) {
+            const std::vector<double> v = values(c);
+            out["mean_" + c] = v.empty() ? json(nullptr) : json(mean(v));
+        }
+        t.rows.push_back(std::move(out));
+    };
+    for (const json& resolution : resolutions) summarize(resolution);
+    summarize("all");
+    return t;
 }
 
 }  // namespace gilab::p2

@@ -30,6 +30,8 @@ const std::vector<ModelSpec>& model_specs();
 const ModelSpec& model_spec(const std::string& scene);  // throws Error naming the known scenes
 // The scene names of the paper's three models, in its order.
 std::vector<std::string> paper_model_scenes();
+// The scene names of every model, in model_specs' order.
+std::vector<std::string> model_scenes();
 
 struct Model {
     std::string label, scene, paper;
@@ -85,5 +87,9 @@ nlohmann::json project(const nlohmann::json& row, const std::vector<std::string>
 std::vector<nlohmann::json> rows_of(const SpecReduction& r, const std::string& kind = "");
 // The machine's load over the tasks that timed something (rows with load averages).
 std::optional<std::string> load_note(const std::vector<nlohmann::json>& rows);
+// Means of `columns` over the rows present, per resolution and over all rows ("all"):
+// columns resolution, rows (those with a number in columns[0]), mean_<column> each.
+ResultTable resolution_means(const std::vector<nlohmann::json>& rows, const std::vector<nlohmann::json>& resolutions,
+                             const std::vector<std::string>& columns);
 
 }  // namespace gilab::p2

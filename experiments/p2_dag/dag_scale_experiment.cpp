@@ -311,38 +311,6 @@ const std::vector<std::string> kColumns = {"scene",
                                            "decode_equal",
                                            "threads"};
 
-// Means over the rows present, per resolution and over all.
-ResultTable summary_table(const std::vector<json>& rows, const std::vector<json>& resolutions) {
-    ResultTable t;
-    t.title = "Mean over the rows present, per resolution and over all rows";
-    t.columns = {"resolution", "rows", "mean_ssvdag_over_svdag", "mean_ssvdag_over_svdag_nodes",
-                 "mean_ssvdag_words_over_packed_leaves", "mean_ssvdag_over_ssvdag_words"};
-    auto summarize = [&](const json& resolution) {
-        // The column's values over the rows at `resolution` (all rows for "all").
-        auto values = [&](const char* column) {
-            std::vector<double> v;
-            for (const json& row : rows)
-                if ((resolution == "all" || row.at("resolution") == resolution) && row.contains(column) &&
-                    row.at(column).is_number())
-                    v.push_back(row.at(column).get<double>());
-            return v;
-        };
-        auto mean_of = [&](const char* column) {
-            const std::vector<double> v = values(column);
-            return v.empty() ? json(nullptr) : json(mean(v));
-        };
-        t.rows.push_back({{"resolution", resolution},
-                          {"rows", values("ssvdag_over_svdag").size()},
-                          {"mean_ssvdag_over_svdag", mean_of("ssvdag_over_svdag")},
-                          {"mean_ssvdag_over_svdag_nodes", mean_of("ssvdag_over_svdag_nodes")},
-                          {"mean_ssvdag_words_over_packed_leaves", mean_of("ssvdag_words_over_packed_leaves")},
-                          {"mean_ssvdag_over_ssvdag_words", mean_of("ssvdag_over_ssvdag_words")}});
-    };
-    for (const json& resolution : resolutions) summarize(resolution);
-    summarize("all");
-    return t;
-}
-
 ExperimentOutput reduce_scale(const SpecReduction& r) {
     ResultTable table;
     table.title = "SVDAG and SSVDAG at scale (MB = 10⁶ bytes, MiB = 2²⁰ bytes, times in wall-clock seconds)";
@@ -351,7 +319,10 @@ ExperimentOutput reduce_scale(const SpecReduction& r) {
     for (const json& row : rows) table.rows.push_back(project(row, table.columns));
     const std::vector<json>& resolutions = r.ctx.quick ? r.spec.axes.at(0).quick : r.spec.axes.at(0).full;
     ExperimentOutput out;
-    out.tables = {std::move(table), summary_table(rows, resolutions)};
+    out.tables = {std::move(table), resolution_means(rows, resolutions,
+                                                                {"ssvdag_over_svdag", "ssvdag_over_svdag_nodes",
+                                                                 "ssvdag_words_over_packed_leaves",
+                                                                 "ssvdag_over_ssvdag_words"})};
 
     // Which resolutions have the 1-thread build (a setting decides it by resolution).
     std::string with_one_thread, without;
@@ -382,8 +353,6 @@ ExperimentOutput reduce_scale(const SpecReduction& r) {
 Experiment dag_scale_experiment() {
     add_probe("dag-scale", model_probe(measure_scale));
     add_reducer("dag-scale", reduce_scale);
-    std::vector<std::string> scenes;
-    for (const ModelSpec& m : model_specs()) scenes.push_back(m.scene);
     return declared_experiment({
         .name = "dag-scale",
         .paper = "P2",
@@ -392,7 +361,7 @@ Experiment dag_scale_experiment() {
                        "castle and three whole scenes, 2048³ to 65536³: nodes, MB, bits per voxel, build and "
                        "conversion times, peak RSS and primary rays/s through both, with the two DAGs checked to "
                        "hold the same voxels",
-        .scenes = scenes,
+        .scenes = model_scenes(),
         .size = 256, .quick_size = 64,
         .variants = {{.name = "SVDAG, SSVDAG",
                       .probe = "dag-scale",

@@ -116,33 +116,6 @@ const std::vector<std::string> kColumns = {"scene",
                                            "cube_merge (s)",
                                            "threads"};
 
-ResultTable summary_table(const std::vector<json>& rows, const std::vector<json>& resolutions) {
-    ResultTable t;
-    t.title = "Mean over the rows present, per resolution and over all rows";
-    t.columns = {"resolution", "rows", "mean_cube_over_reflection_nodes", "mean_cube_words_over_reflection_words"};
-    auto summarize = [&](const json& resolution) {
-        auto values = [&](const char* column) {
-            std::vector<double> v;
-            for (const json& row : rows)
-                if ((resolution == "all" || row.at("resolution") == resolution) && row.contains(column) &&
-                    row.at(column).is_number())
-                    v.push_back(row.at(column).get<double>());
-            return v;
-        };
-        auto mean_of = [&](const char* column) {
-            const std::vector<double> v = values(column);
-            return v.empty() ? json(nullptr) : json(mean(v));
-        };
-        t.rows.push_back({{"resolution", resolution},
-                          {"rows", values("cube_over_reflection_nodes").size()},
-                          {"mean_cube_over_reflection_nodes", mean_of("cube_over_reflection_nodes")},
-                          {"mean_cube_words_over_reflection_words", mean_of("cube_words_over_reflection_words")}});
-    };
-    for (const json& resolution : resolutions) summarize(resolution);
-    summarize("all");
-    return t;
-}
-
 ExperimentOutput reduce_symmetries(const SpecReduction& r) {
     ResultTable table;
     table.title = "SVDAG merged under the 8 reflections and under the 48 cube symmetries (MB = 10⁶ bytes, times in "
@@ -152,7 +125,9 @@ ExperimentOutput reduce_symmetries(const SpecReduction& r) {
     for (const json& row : rows) table.rows.push_back(project(row, table.columns));
     const std::vector<json>& resolutions = r.ctx.quick ? r.spec.axes.at(0).quick : r.spec.axes.at(0).full;
     ExperimentOutput out;
-    out.tables = {std::move(table), summary_table(rows, resolutions)};
+    out.tables = {std::move(table), resolution_means(rows, resolutions,
+                                                                {"cube_over_reflection_nodes",
+                                                                 "cube_words_over_reflection_words"})};
     if (auto note = load_note(rows)) out.notes.push_back(*note);
     return out;
 }
@@ -162,8 +137,6 @@ ExperimentOutput reduce_symmetries(const SpecReduction& r) {
 Experiment dag_symmetry_experiment() {
     add_probe("dag-symmetries", model_probe(measure_symmetries));
     add_reducer("dag-symmetries", reduce_symmetries);
-    std::vector<std::string> scenes;
-    for (const ModelSpec& m : model_specs()) scenes.push_back(m.scene);
     return declared_experiment({
         .name = "dag-symmetries",
         .paper = "P2",
@@ -171,7 +144,7 @@ Experiment dag_symmetry_experiment() {
         .description = "The SVDAG of each P2 model and scene merged under the SSVDAG's 8 reflections and under all "
                        "48 symmetries of the cube (axis permutations with reflections): nodes and bytes in the same "
                        "32-bit word layout, and how many pointers need a permutation",
-        .scenes = scenes,
+        .scenes = model_scenes(),
         .variants = {{.name = "reflections, cube symmetries", .probe = "dag-symmetries", .settings = json::object()}},
         .axes = {{"resolution", {2048, 4096, 8192}, {64, 128}}},
         .reducer = "dag-symmetries",

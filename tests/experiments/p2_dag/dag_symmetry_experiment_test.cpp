@@ -6,31 +6,21 @@
 #include <string>
 #include "experiments/runner/experiment.hpp"
 #include "experiments/runner/spec_runner.hpp"
-#include "tests/experiment_test_support.hpp"
-#include "tests/test_support.hpp"
+#include "tests/experiments/p2_dag/dag_model_test_support.hpp"
 
 namespace {
 
 using namespace gilab;
 using nlohmann::json;
 
-const ExperimentRegistry& dag_registry() {
-    static const ExperimentRegistry registry = test::registry_with({register_dag_experiments});
-    return registry;
-}
-
-double num(const json& row, const std::string& column) {
-    EXPECT_TRUE(row.contains(column) && row.at(column).is_number()) << "no number in " << column << ": " << row.dump();
-    return row.contains(column) && row.at(column).is_number() ? row.at(column).get<double>() : 0.0;
-}
+using test::dag_registry;
+using test::num;
 
 class DagSymmetryTest : public ::testing::Test {
 protected:
     void SetUp() override {
-        for (const char* mesh : {"bunny/stanford-bunny.obj", "buddha/buddha.obj", "dragon/dragon.obj",
-                                 "castle/fincastel.obj", "sponza/sponza.obj", "sibenik/sibenik.obj",
-                                 "conference/conference.obj"})
-            if (!test::shared_asset(mesh)) GTEST_SKIP() << mesh << " not found in the shared scenes (set GILAB_ASSETS)";
+        const std::string missing = test::missing_model_mesh();
+        if (!missing.empty()) GTEST_SKIP() << missing << " not found in the shared scenes (set GILAB_ASSETS)";
     }
 
     static const ExperimentOutput& quick() {
