@@ -14,6 +14,12 @@
 //  - BM_SampleLevel: one trilinear face-weighted sample (the inner loop of every cone),
 //    from a one-voxel neighbourhood (cache-resident), scattered over the finest level,
 //    or scattered over every level; with or without the clip plane.
+//  - BM_TexelFloor: the machine's cost of the work every sample of this format must do
+//    and nothing else: the 24 RGBA16F texels (8 voxels × 3 faces) of a trilinear,
+//    face-weighted sample loaded, converted and weighted, with the addresses and weights
+//    already known (the cheapest form we know: x pairs, 12 conversions and 12 fused
+//    multiply-adds of 8 lanes), over a level-sized buffer in cache. A frame's sample count
+//    times this is the least time a CPU sampler of this format can take;
 //  - BM_ReadBandwidth: the machine's read bandwidth (summing 64-bit words) from a buffer
 //    the size of one cascade level's radiance (1.5 MiB: cache) and of 256 MiB (memory),
 //    the bound a cone sampler would meet if it were limited by the bytes it reads.
@@ -24,6 +30,9 @@
 #include <benchmark/benchmark.h>
 
 #include <atomic>
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -393,6 +402,76 @@ BENCHMARK(BM_SampleLevel)
     ->ArgsProduct({{0, 1}, {0, 1, 2}, {0, 1}, {0, 1}})
     ->ArgNames({"structure", "pattern", "plane", "kernel"})
     ->Unit(benchmark::kMicrosecond);
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+// One precomputed sample for BM_TexelFloor: the cells of the lower and upper voxel along
+// x of its four (y, z) corners, its three faces, and its weights.
+struct FloorSample {
+    int lower[4], upper[4];
+    int face[3];
+    float wzy[4], wx[2], face_weight[3];
+};
+
+__attribute__((target("avx2,fma,f16c"))) float texel_floor_pass(const HalfRGBA* cells,
+                                                                const std::vector<FloorSample>& samples) {
+    __m128 total = _mm_setzero_ps();
+    for (const FloorSample& s : samples) {
+        const __m256 wx = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_set1_ps(s.wx[0])), _mm_set1_ps(s.wx[1]), 1);
+        __m256 acc[3] = {_mm256_setzero_ps(), _mm256_setzero_ps(), _mm256_setzero_ps()};
+        for (int j = 0; j < 4; ++j) {
+            const __m256 w = _mm256_mul_ps(_mm256_set1_ps(s.wzy[j]), wx);
+            for (int f = 0; f < 3; ++f) {
+                const HalfRGBA* face = cells + s.face[f];
+                const __m128 low = _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(face + s.lower[j])));
+                const __m128 both = _mm_loadh_pi(low, reinterpret_cast<const __m64*>(face + s.upper[j]));
+                acc[f] = _mm256_fmadd_ps(_mm256_cvtph_ps(_mm_castps_si128(both)), w, acc[f]);
+            }
+        }
+        __m256 sum = _mm256_mul_ps(acc[0], _mm256_set1_ps(s.face_weight[0]));
+        sum = _mm256_fmadd_ps(acc[1], _mm256_set1_ps(s.face_weight[1]), sum);
+        sum = _mm256_fmadd_ps(acc[2], _mm256_set1_ps(s.face_weight[2]), sum);
+        total = _mm_add_ps(total, _mm_add_ps(_mm256_castps256_ps128(sum), _mm256_extractf128_ps(sum, 1)));
+    }
+    return _mm_cvtss_f32(total);
+}
+
+// One thread; samples scattered over one 32³ level of six faces (1.5 MiB, the cascades'
+// level size) or over a 4³ block of it (every texel in L1).
+void BM_TexelFloor(benchmark::State& state) {
+    if (best_cone_kernel() != ConeKernel::avx2) {
+        state.SkipWithError("this CPU lacks AVX2, FMA or F16C");
+        return;
+    }
+    const int span = int(state.range(0));
+    constexpr int kR = 32;
+    std::vector<HalfRGBA> cells(size_t(kR) * kR * kR * kFaceCount);
+    Rng rng(5, 3);
+    for (HalfRGBA& c : cells) c = to_half_rgba(Vec4(rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform()));
+    std::vector<FloorSample> samples(size_t(1) << 16);
+    auto cell = [](int x, int y, int z) { return ((z * kR + y) * kR + x) * kFaceCount; };
+    for (FloorSample& s : samples) {
+        int v[3];
+        for (int& c : v) c = std::min(int(rng.uniform() * float(span - 1)), span - 2);
+        for (int j = 0; j < 4; ++j) {
+            s.lower[j] = cell(v[0], v[1] + (j & 1), v[2] + (j >> 1));
+            s.upper[j] = s.lower[j] + kFaceCount;
+        }
+        for (int a = 0; a < 3; ++a) {
+            s.face[a] = 2 * a + (rng.uniform() < 0.5f ? 1 : 0);
+            s.face_weight[a] = rng.uniform();
+        }
+        for (float& w : s.wzy) w = rng.uniform();
+        s.wx[0] = rng.uniform();
+        s.wx[1] = 1.0f - s.wx[0];
+    }
+    benchmark::DoNotOptimize(texel_floor_pass(cells.data(), samples));  // warm-up
+    for (auto _ : state) benchmark::DoNotOptimize(texel_floor_pass(cells.data(), samples));
+    const double n = double(state.iterations()) * double(samples.size());
+    state.counters["s_per_sample"] = benchmark::Counter(n, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+    state.SetLabel(span == kR ? "one 32³ level (1.5 MiB)" : "a " + std::to_string(span) + "³ block (L1)");
+}
+BENCHMARK(BM_TexelFloor)->Arg(4)->Arg(32)->ArgName("span")->Unit(benchmark::kMicrosecond);
+#endif
 
 void BM_ReadBandwidth(benchmark::State& state) {
     const size_t bytes = size_t(state.range(0)) << 10;

@@ -226,146 +226,161 @@ template <bool kClip>
     return accumulate_portable<true>(l, c, faces, keep);
 }
 
+using SampleFn = Vec4 (*)(const ConeLevel&, const Vec3&, const Vec3&, const FaceWeights&, const Vec4*);
+
+namespace portable_kernel {
+#include "techniques/vct/cone_march.inc"
+}  // namespace portable_kernel
+
+ConeResult trace_cone_portable(const VoxelConeView& view, const Cone& cone, const ConeOptions& options) {
+    return portable_kernel::march<sample_portable>(view, cone, options);
+}
+
 #if GILAB_CONE_AVX2
-// ---- AVX2 kernel: the eight texel weights and the clip plane's mask in one 8-wide
-// register each; F16C converts a texel's four halves in one instruction and FMA folds the
-// weighting (the same sums as the portable kernel in another order, with fused rounding).
-// Per-axis pairs v[a][0 or 1] spread over the eight texels (texel k takes bit 0 of k
-// along x, bit 1 along y, bit 2 along z, as texel_offset).
+// Everything up to the matching pop is compiled with AVX2, FMA and F16C.
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx2,fma,f16c"))), apply_to = function)
+#else
+#pragma GCC push_options
+#pragma GCC target("avx2,fma,f16c")
+#endif
+// ---- AVX2 kernel: texels in x pairs. A pair, the lower and the upper voxel along x at
+// one (y, z) corner for one face, is two 8-byte loads into one register, which F16C
+// converts to eight floats in one instruction and FMA weights in one more: 12
+// conversions and 12 fused multiply-adds per sample instead of 24 each. The eight texel
+// weights (texel_weight's order of products) and the clip plane's masks (clip_mask's
+// order of sums) are computed once, eight texels wide, and each pair takes its two lanes
+// spread over the lower and upper four lanes. The same sums as the portable kernel in
+// another order, with fused rounding.
+#define GILAB_AVX2_INLINE [[gnu::always_inline]] inline
+
+GILAB_AVX2_INLINE __m256 load_pair(const HalfRGBA* lower, const HalfRGBA* upper) {
+    const __m128 low = _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(lower)));
+    return _mm256_cvtph_ps(_mm_castps_si128(_mm_loadh_pi(low, reinterpret_cast<const __m64*>(upper))));
+}
+// Per axis a of lanes (lower voxel: 0–2, upper voxel: 4–6) spread over the eight texels
+// (texel k takes bit 0 of k along x, bit 1 along y, bit 2 along z, as texel_offset).
 struct Texels8 {
     __m256 x, y, z;
 };
-__attribute__((target("avx2,fma,f16c"), always_inline)) inline Texels8 spread(const float (&v)[3][2]) {
-    return {_mm256_setr_ps(v[0][0], v[0][1], v[0][0], v[0][1], v[0][0], v[0][1], v[0][0], v[0][1]),
-            _mm256_setr_ps(v[1][0], v[1][0], v[1][1], v[1][1], v[1][0], v[1][0], v[1][1], v[1][1]),
-            _mm256_setr_ps(v[2][0], v[2][0], v[2][0], v[2][0], v[2][1], v[2][1], v[2][1], v[2][1])};
+GILAB_AVX2_INLINE Texels8 spread(__m128 lower, __m128 upper) {
+    const __m256 both = _mm256_insertf128_ps(_mm256_castps128_ps256(lower), upper, 1);
+    return {_mm256_permutevar8x32_ps(both, _mm256_setr_epi32(0, 4, 0, 4, 0, 4, 0, 4)),
+            _mm256_permutevar8x32_ps(both, _mm256_setr_epi32(1, 1, 5, 5, 1, 1, 5, 5)),
+            _mm256_permutevar8x32_ps(both, _mm256_setr_epi32(2, 2, 2, 2, 6, 6, 6, 6))};
 }
-// texel_weight of the eight texels, in texel_weight's order of products.
-__attribute__((target("avx2,fma,f16c"), always_inline)) inline __m256 texel_product(const float (&v)[3][2]) {
-    const Texels8 t = spread(v);
-    return _mm256_mul_ps(_mm256_mul_ps(t.z, t.y), t.x);
-}
-// clip_mask's sum of the per-axis distances of the eight texels, in its order.
-__attribute__((target("avx2,fma,f16c"), always_inline)) inline __m256 texel_sum(const float (&v)[3][2]) {
-    const Texels8 t = spread(v);
-    return _mm256_add_ps(_mm256_add_ps(t.x, t.y), t.z);
+// Texels 2j and 2j + 1 (the x pair of corner j) of eight lanes, each over four lanes.
+GILAB_AVX2_INLINE __m256 pair_lanes(__m256 texels, int j) {
+    return _mm256_permutevar8x32_ps(texels, _mm256_setr_epi32(2 * j, 2 * j, 2 * j, 2 * j, 2 * j + 1, 2 * j + 1,
+                                                              2 * j + 1, 2 * j + 1));
 }
 
-__attribute__((target("avx2,fma,f16c"))) Vec4 sample_avx2(const ConeLevel& l, const Vec3& anchor, const Vec3& p,
-                                                          const FaceWeights& faces, const Vec4* plane) {
-    const SampleCorners c = corners_of(l, (p - anchor) * l.inv_voxel_size);
-    if (l.occupancy && !occupancy_bit(l.occupancy, c.occupancy)) return Vec4(0.0f);  // all eight texels empty
-    const __m256 w = texel_product(c.weight);
-    alignas(32) float wf[3][8];
-    if (!plane) {
-        _mm256_store_ps(wf[0], w);
-        _mm256_store_ps(wf[1], w);
-        _mm256_store_ps(wf[2], w);
+// corners_of for the three axes at once (SSE lanes x, y, z; the same clamps, floors and
+// weights, so the same numbers): lanes of i0 and i1, the weights of the lower and the
+// upper voxel, and the cells of the x pairs, lower[j] and upper[j] for the (y, z) corner j
+// (bit 0 along y, bit 1 along z). Cells are computed in 32 bits, which holds levels of at
+// most 512³ voxels of six faces (sample_avx2_inline checks).
+struct PairCorners {
+    __m128i i0, i1;
+    __m128 w0, w1;
+    int lower[4], upper[4];
+    int occupancy;
+};
+GILAB_AVX2_INLINE PairCorners pair_corners_of(const ConeLevel& l, const Vec3& anchor, const Vec3& p) {
+    const __m128 pos = _mm_setr_ps(p.x, p.y, p.z, 0.0f), anc = _mm_setr_ps(anchor.x, anchor.y, anchor.z, 0.0f);
+    const __m128i lo_i = _mm_setr_epi32(l.origin.x, l.origin.y, l.origin.z, 0);
+    const __m128i hi_i = _mm_add_epi32(lo_i, _mm_set1_epi32(l.size - 1));
+    __m128 q = _mm_sub_ps(_mm_mul_ps(_mm_sub_ps(pos, anc), _mm_set1_ps(l.inv_voxel_size)), _mm_set1_ps(0.5f));
+    q = _mm_min_ps(_mm_max_ps(q, _mm_cvtepi32_ps(lo_i)), _mm_cvtepi32_ps(hi_i));
+    const __m128 f = _mm_floor_ps(q);
+    PairCorners c;
+    c.i0 = _mm_cvttps_epi32(f);
+    c.i1 = _mm_min_epi32(_mm_add_epi32(c.i0, _mm_set1_epi32(1)), hi_i);
+    c.w1 = _mm_sub_ps(q, f);
+    c.w0 = _mm_sub_ps(_mm_set1_ps(1.0f), c.w1);
+    const __m128i wrap = _mm_set1_epi32(l.wrap_mask);
+    const __m128i t0 = _mm_and_si128(c.i0, wrap), t1 = _mm_and_si128(c.i1, wrap);
+    const __m128i stride = _mm_setr_epi32(int(l.x_stride), int(l.row_stride), int(l.slice_stride), 0);
+    const __m128i o0 = _mm_mullo_epi32(t0, stride), o1 = _mm_mullo_epi32(t1, stride);
+    // Rows: the z and y cells of corner j, then the x cells added.
+    const __m128i xy = _mm_unpacklo_epi32(o0, o1);                                         // x0 x1 y0 y1
+    const __m128i oy = _mm_shuffle_epi32(xy, _MM_SHUFFLE(3, 2, 3, 2));                     // y0 y1 y0 y1
+    const __m128i oz = _mm_shuffle_epi32(_mm_unpackhi_epi32(o0, o1), _MM_SHUFFLE(1, 1, 0, 0));  // z0 z0 z1 z1
+    const __m128i row = _mm_add_epi32(oz, oy);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(c.lower), _mm_add_epi32(row, _mm_shuffle_epi32(o0, 0)));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(c.upper), _mm_add_epi32(row, _mm_shuffle_epi32(o1, 0)));
+    const __m128i occ = _mm_mullo_epi32(t0, _mm_setr_epi32(1, int(l.occupancy_row), int(l.occupancy_slice), 0));
+    c.occupancy = _mm_cvtsi128_si32(_mm_add_epi32(_mm_add_epi32(occ, _mm_shuffle_epi32(occ, 1)), _mm_shuffle_epi32(occ, 2)));
+    return c;
+}
+
+GILAB_AVX2_INLINE Vec4 sample_avx2_inline(const ConeLevel& l, const Vec3& anchor, const Vec3& p,
+                                          const FaceWeights& faces, const Vec4* plane) {
+    if (l.size > 512) return sample_portable(l, anchor, p, faces, plane);
+    const PairCorners c = pair_corners_of(l, anchor, p);
+    if (l.occupancy && !occupancy_bit(l.occupancy, size_t(c.occupancy))) return Vec4(0.0f);  // all eight texels empty
+    const HalfRGBA* face[3];
+    for (int f = 0; f < 3; ++f) face[f] = l.data + size_t(faces.face[size_t(f)]) * l.face_stride;
+    const Texels8 w = spread(c.w0, c.w1);
+    const __m256 weight = _mm256_mul_ps(_mm256_mul_ps(w.z, w.y), w.x);
+    const __m256 zero = _mm256_setzero_ps();
+    __m256 acc[3] = {zero, zero, zero};
+    if (plane) {
+        // clip_geometry: n[a] × (anchor[a] + (i + 0.5) × voxel) for i0 and i1, then
+        // clip_mask's rule: a face turned to the plane's front keeps texels whose box
+        // reaches in front of it, the other faces only texels wholly in front.
+        const __m128 n = _mm_setr_ps(plane->x, plane->y, plane->z, 0.0f);
+        const __m128 anc = _mm_setr_ps(anchor.x, anchor.y, anchor.z, 0.0f), vs = _mm_set1_ps(l.voxel_size);
+        const __m128 h = _mm_set1_ps(0.5f);
+        const __m128 s0 = _mm_mul_ps(n, _mm_add_ps(anc, _mm_mul_ps(_mm_add_ps(_mm_cvtepi32_ps(c.i0), h), vs)));
+        const __m128 s1 = _mm_mul_ps(n, _mm_add_ps(anc, _mm_mul_ps(_mm_add_ps(_mm_cvtepi32_ps(c.i1), h), vs)));
+        const Texels8 s = spread(s0, s1);
+        const __m256 d = _mm256_sub_ps(_mm256_add_ps(_mm256_add_ps(s.x, s.y), s.z), _mm256_set1_ps(plane->w));
+        const __m256 half =
+            _mm256_set1_ps(0.501f * l.voxel_size * (std::abs(plane->x) + std::abs(plane->y) + std::abs(plane->z)));
+        const __m256 front = _mm256_and_ps(weight, _mm256_cmp_ps(_mm256_add_ps(d, half), zero, _CMP_GT_OQ));
+        const __m256 back = _mm256_and_ps(weight, _mm256_cmp_ps(_mm256_sub_ps(d, half), zero, _CMP_GT_OQ));
+        __m256 face_weight[3];
+        for (int f = 0; f < 3; ++f) face_weight[f] = faces_plane_front(faces.face[size_t(f)], *plane) ? front : back;
+        for (int j = 0; j < 4; ++j)  // the (y, z) corner: bit 0 along y, bit 1 along z
+            for (int f = 0; f < 3; ++f)
+                acc[f] = _mm256_fmadd_ps(load_pair(face[f] + c.lower[j], face[f] + c.upper[j]),
+                                         pair_lanes(face_weight[f], j), acc[f]);
     } else {
-        // clip_mask's rule, eight texels at once.
-        const ClipGeometry g = clip_geometry(l, anchor, c, *plane);
-        const __m256 d = _mm256_sub_ps(texel_sum(g.s), _mm256_set1_ps(plane->w));
-        const __m256 h = _mm256_set1_ps(g.half);
-        const __m256 front = _mm256_and_ps(w, _mm256_cmp_ps(_mm256_add_ps(d, h), _mm256_setzero_ps(), _CMP_GT_OQ));
-        const __m256 back = _mm256_and_ps(w, _mm256_cmp_ps(_mm256_sub_ps(d, h), _mm256_setzero_ps(), _CMP_GT_OQ));
-        for (int f = 0; f < 3; ++f) _mm256_store_ps(wf[f], faces_plane_front(faces.face[size_t(f)], *plane) ? front : back);
+        for (int j = 0; j < 4; ++j) {
+            const __m256 pair_weight = pair_lanes(weight, j);
+            for (int f = 0; f < 3; ++f)
+                acc[f] = _mm256_fmadd_ps(load_pair(face[f] + c.lower[j], face[f] + c.upper[j]), pair_weight, acc[f]);
+        }
     }
-    const HalfRGBA* face0 = l.data + size_t(faces.face[0]) * l.face_stride;
-    const HalfRGBA* face1 = l.data + size_t(faces.face[1]) * l.face_stride;
-    const HalfRGBA* face2 = l.data + size_t(faces.face[2]) * l.face_stride;
-    // Two accumulators per face (even and odd texels) halve the chain of dependent FMAs.
-    __m128 a[3][2] = {{_mm_setzero_ps(), _mm_setzero_ps()}, {_mm_setzero_ps(), _mm_setzero_ps()},
-                      {_mm_setzero_ps(), _mm_setzero_ps()}};
-#define GILAB_TEXEL(face, off) _mm_cvtph_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>((face) + (off))))
-    for (int k = 0; k < 8; ++k) {
-        const size_t off = texel_offset(c, k);
-        a[0][k & 1] = _mm_fmadd_ps(GILAB_TEXEL(face0, off), _mm_broadcast_ss(&wf[0][k]), a[0][k & 1]);
-        a[1][k & 1] = _mm_fmadd_ps(GILAB_TEXEL(face1, off), _mm_broadcast_ss(&wf[1][k]), a[1][k & 1]);
-        a[2][k & 1] = _mm_fmadd_ps(GILAB_TEXEL(face2, off), _mm_broadcast_ss(&wf[2][k]), a[2][k & 1]);
-    }
-#undef GILAB_TEXEL
-    __m128 sum = _mm_mul_ps(_mm_add_ps(a[0][0], a[0][1]), _mm_set1_ps(faces.weight[0]));
-    sum = _mm_fmadd_ps(_mm_add_ps(a[1][0], a[1][1]), _mm_set1_ps(faces.weight[1]), sum);
-    sum = _mm_fmadd_ps(_mm_add_ps(a[2][0], a[2][1]), _mm_set1_ps(faces.weight[2]), sum);
+    __m256 sum = _mm256_mul_ps(acc[0], _mm256_set1_ps(faces.weight[0]));
+    sum = _mm256_fmadd_ps(acc[1], _mm256_set1_ps(faces.weight[1]), sum);
+    sum = _mm256_fmadd_ps(acc[2], _mm256_set1_ps(faces.weight[2]), sum);
     alignas(16) float out[4];
-    _mm_store_ps(out, sum);
+    _mm_store_ps(out, _mm_add_ps(_mm256_castps256_ps128(sum), _mm256_extractf128_ps(sum, 1)));
     return {out[0], out[1], out[2], out[3]};
 }
+#undef GILAB_AVX2_INLINE
+
+// The same, as a function of its own (sample_level calls it from code built without AVX2).
+Vec4 sample_avx2(const ConeLevel& l, const Vec3& anchor, const Vec3& p, const FaceWeights& faces, const Vec4* plane) {
+    return sample_avx2_inline(l, anchor, p, faces, plane);
+}
+
+namespace avx2_kernel {
+#include "techniques/vct/cone_march.inc"
+}  // namespace avx2_kernel
+
+ConeResult trace_cone_avx2(const VoxelConeView& view, const Cone& cone, const ConeOptions& options) {
+    return avx2_kernel::march<sample_avx2_inline>(view, cone, options);
+}
+
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
+#pragma GCC pop_options
 #endif
-
-using SampleFn = Vec4 (*)(const ConeLevel&, const Vec3&, const Vec3&, const FaceWeights&, const Vec4*);
-
-// The cone loop, instantiated once per kernel.
-template <SampleFn kSample>
-[[gnu::always_inline]] inline ConeResult march(const VoxelConeView& view, const Cone& cone, const ConeOptions& options) {
-    ConeResult r;
-    const int n = view.level_count();
-    if (n == 0) return r;
-    const float w0 = view.base_voxel_size(), inv_w0 = 1.0f / w0;
-    const float coarsest = view.level(n - 1).voxel_size;
-    const float bias_scale = std::exp2(options.lod_bias);
-    const FaceWeights faces = faces_seen_along(cone.direction);
-    const Vec4* plane = options.clip ? &options.clip_plane : nullptr;
-    // A sample farther in front of the clip plane than its eight voxel centres reach (one
-    // voxel per axis) plus clip_mask's half-voxel test is never clipped; blending also
-    // reads the next level, of twice the voxel.
-    const float plane_reach = plane ? 1.502f * (options.blend_levels ? 2.0f : 1.0f) *
-                                          (std::abs(plane->x) + std::abs(plane->y) + std::abs(plane->z))
-                                    : 0.0f;
-    float dist = options.start;
-    while (dist < options.max_distance) {
-        const Vec3 p = cone.origin + dist * cone.direction;
-        const float diameter = std::max(2.0f * cone.tan_half_angle * dist, w0);
-        if (!options.bounds.empty()) {
-            // The footprint has left the box (convex): nothing further along is met.
-            const Vec3 grow(0.5f * diameter + 2.0f * w0);
-            const Vec3 lo = options.bounds.min - grow, hi = options.bounds.max + grow;
-            if (p.x < lo.x || p.y < lo.y || p.z < lo.z || p.x > hi.x || p.y > hi.y || p.z > hi.z) break;
-        }
-        // Eq. 2: the voxel width matching the footprint, w0·2^lod (lod continuous, with
-        // the bias), read at level max(⌊lod⌋, finest level holding p), at most the coarsest.
-        const float lod_width = diameter * bias_scale;
-        const float ratio = lod_width * inv_w0;
-        const int lod = ratio < 1.0f ? 0 : int((std::bit_cast<uint32_t>(ratio) >> 23) & 0xffu) - 127;
-        const int l0 = view.level_containing(p, lod, 1.0f);
-        if (l0 < 0) break;  // left the structure
-        // The continuous level's voxel: the footprint's own width unless p is held only by
-        // a coarser level (then that level's voxel) or beyond the coarsest.
-        const float voxel = l0 > lod ? view.level(l0).voxel_size : std::clamp(lod_width, w0, coarsest);
-        const Vec4* clip = plane && glm::dot(Vec3(*plane), p) - plane->w <= plane_reach * voxel ? plane : nullptr;
-        Vec4 s = kSample(view.level(l0), view.anchor(), p, faces, clip);
-        if (options.blend_levels && l0 + 1 < n) {
-            const float frac = std::log2(voxel / view.level(l0).voxel_size);
-            if (frac > 0.0f) s = glm::mix(s, kSample(view.level(l0 + 1), view.anchor(), p, faces, clip), frac);
-        }
-        const float step = voxel * options.step;  // the sampled level's voxel: never skips over it
-        ++r.samples;
-        if (s.a > 1e-6f) {
-            const float a = std::min(s.a, 0.9999f);
-            const float corrected = options.correct_opacity ? 1.0f - std::pow(1.0f - a, step / voxel) : a;
-            const Vec3 col = Vec3(s) * (corrected / s.a);
-            const float t = 1.0f - r.opacity;
-            r.radiance += t * col;
-            const float radius = 0.5f * diameter / w0;
-            r.occlusion += (1.0f - r.occlusion) * corrected / (1.0f + options.ao_lambda * radius);
-            r.opacity += t * corrected;
-            if (r.opacity >= options.opacity_cutoff) break;
-        }
-        dist += step;
-    }
-    return r;
-}
-
-ConeResult trace_cone_portable(const VoxelConeView& view, const Cone& cone, const ConeOptions& options) {
-    return march<sample_portable>(view, cone, options);
-}
-
-#if GILAB_CONE_AVX2
-__attribute__((target("avx2,fma,f16c"))) ConeResult trace_cone_avx2(const VoxelConeView& view, const Cone& cone,
-                                                                    const ConeOptions& options) {
-    return march<sample_avx2>(view, cone, options);
-}
-#endif
+#endif  // GILAB_CONE_AVX2
 
 void require_supported(ConeKernel kernel) {
     if (kernel == ConeKernel::avx2 && best_cone_kernel() != ConeKernel::avx2)
