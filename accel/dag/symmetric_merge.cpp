@@ -198,10 +198,7 @@ SymmetricDagCounts count_symmetric_dag(const Svdag& dag) {
         c.level_nodes[size_t(dag.depth() - 1)] = merge.leaf_masks().size();
         c.word_bytes += 4 * ((merge.leaf_masks().size() + 3) / 4);
     }
-    for (uint64_t n : c.level_nodes) {
-        c.nodes += n;
-        c.largest_level = std::max(c.largest_level, n);
-    }
+    for (uint64_t n : c.level_nodes) c.nodes += n;
     return c;
 }
 

@@ -69,7 +69,6 @@ struct SymmetricDagCounts {
     // Every header and pointer a 32-bit word, the voxels' parents' masks four to a word
     // (Ssvdag::word_bytes for the reflections).
     uint64_t word_bytes = 0;
-    uint64_t largest_level = 0;          // nodes on the fullest stored level
 };
 
 template <class Group>

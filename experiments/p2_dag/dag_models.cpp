@@ -159,4 +159,18 @@ ResultTable resolution_means(const std::vector<json>& rows, const std::vector<js
     return t;
 }
 
+const std::vector<json>& plan_resolutions(const SpecReduction& r) {
+    return r.ctx.quick ? r.spec.axes.at(0).quick : r.spec.axes.at(0).full;
+}
+
+std::vector<ResultTable> scale_tables(const SpecReduction& r, const std::vector<json>& rows, std::string title,
+                                      const std::vector<std::string>& columns,
+                                      const std::vector<std::string>& mean_columns) {
+    ResultTable table;
+    table.title = std::move(title);
+    table.columns = columns;
+    for (const json& row : rows) table.rows.push_back(project(row, table.columns));
+    return {std::move(table), resolution_means(rows, plan_resolutions(r), mean_columns)};
+}
+
 }  // namespace gilab::p2

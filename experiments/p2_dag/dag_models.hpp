@@ -91,5 +91,12 @@ std::optional<std::string> load_note(const std::vector<nlohmann::json>& rows);
 // columns resolution, rows (those with a number in columns[0]), mean_<column> each.
 ResultTable resolution_means(const std::vector<nlohmann::json>& rows, const std::vector<nlohmann::json>& resolutions,
                              const std::vector<std::string>& columns);
+// The resolutions of the plan that ran (quick or full): a scale experiment's first axis.
+const std::vector<nlohmann::json>& plan_resolutions(const SpecReduction& r);
+// A scale experiment's tables: `rows` projected onto `columns` under `title`, then the
+// resolution_means of `mean_columns` over plan_resolutions.
+std::vector<ResultTable> scale_tables(const SpecReduction& r, const std::vector<nlohmann::json>& rows,
+                                      std::string title, const std::vector<std::string>& columns,
+                                      const std::vector<std::string>& mean_columns);
 
 }  // namespace gilab::p2

@@ -312,17 +312,14 @@ const std::vector<std::string> kColumns = {"scene",
                                            "threads"};
 
 ExperimentOutput reduce_scale(const SpecReduction& r) {
-    ResultTable table;
-    table.title = "SVDAG and SSVDAG at scale (MB = 10⁶ bytes, MiB = 2²⁰ bytes, times in wall-clock seconds)";
-    table.columns = kColumns;
     const std::vector<json> rows = rows_of(r);
-    for (const json& row : rows) table.rows.push_back(project(row, table.columns));
-    const std::vector<json>& resolutions = r.ctx.quick ? r.spec.axes.at(0).quick : r.spec.axes.at(0).full;
+    const std::vector<json>& resolutions = plan_resolutions(r);
     ExperimentOutput out;
-    out.tables = {std::move(table), resolution_means(rows, resolutions,
-                                                                {"ssvdag_over_svdag", "ssvdag_over_svdag_nodes",
-                                                                 "ssvdag_words_over_packed_leaves",
-                                                                 "ssvdag_over_ssvdag_words"})};
+    out.tables = scale_tables(r, rows,
+                              "SVDAG and SSVDAG at scale (MB = 10⁶ bytes, MiB = 2²⁰ bytes, times in wall-clock seconds)",
+                              kColumns,
+                              {"ssvdag_over_svdag", "ssvdag_over_svdag_nodes", "ssvdag_words_over_packed_leaves",
+                               "ssvdag_over_ssvdag_words"});
 
     // Which resolutions have the 1-thread build (a setting decides it by resolution).
     std::string with_one_thread, without;

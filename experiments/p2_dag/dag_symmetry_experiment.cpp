@@ -117,17 +117,12 @@ const std::vector<std::string> kColumns = {"scene",
                                            "threads"};
 
 ExperimentOutput reduce_symmetries(const SpecReduction& r) {
-    ResultTable table;
-    table.title = "SVDAG merged under the 8 reflections and under the 48 cube symmetries (MB = 10⁶ bytes, times in "
-                  "wall-clock seconds)";
-    table.columns = kColumns;
     const std::vector<json> rows = rows_of(r);
-    for (const json& row : rows) table.rows.push_back(project(row, table.columns));
-    const std::vector<json>& resolutions = r.ctx.quick ? r.spec.axes.at(0).quick : r.spec.axes.at(0).full;
     ExperimentOutput out;
-    out.tables = {std::move(table), resolution_means(rows, resolutions,
-                                                                {"cube_over_reflection_nodes",
-                                                                 "cube_words_over_reflection_words"})};
+    out.tables = scale_tables(r, rows,
+                              "SVDAG merged under the 8 reflections and under the 48 cube symmetries (MB = 10⁶ "
+                              "bytes, times in wall-clock seconds)",
+                              kColumns, {"cube_over_reflection_nodes", "cube_words_over_reflection_words"});
     if (auto note = load_note(rows)) out.notes.push_back(*note);
     return out;
 }
