@@ -19,7 +19,8 @@
 //    face-weighted sample loaded, converted and weighted, with the addresses and weights
 //    already known (the cheapest form we know: x pairs, 12 conversions and 12 fused
 //    multiply-adds of 8 lanes), over a level-sized buffer in cache. A frame's sample count
-//    times this is the least time a CPU sampler of this format can take;
+//    times this is the least time a sampler that loads and converts every sample's texels
+//    can take;
 //  - BM_ReadBandwidth: the machine's read bandwidth (summing 64-bit words) from a buffer
 //    the size of one cascade level's radiance (1.5 MiB: cache) and of 256 MiB (memory),
 //    the bound a cone sampler would meet if it were limited by the bytes it reads.

@@ -12,9 +12,9 @@
 // the two nearest levels). The three faces turned towards the apex are blended by the
 // squared direction components; a sample whose eight texels the level's occupancy map
 // marks empty reads nothing. Texels are RGBA16F (accel/vct/half_rgba.hpp), weighted four
-// channels at a time (SSE2, or F16C + FMA where the CPU has them: ConeKernel). Samples are composited front to
-// back (eq. 3 on premultiplied colour: c += (1 − α)·c₂, α += (1 − α)·α₂; the paper's
-// "c = αc + …" as printed would scale earlier samples down and lose energy); the step is
+// channels at a time (SSE2), or two texels' eight at a time where the CPU has AVX2, F16C
+// and FMA (ConeKernel). Samples are composited front to back (eq. 3 on premultiplied
+// colour: c += (1 − α)·c₂, α += (1 − α)·α₂; the paper's "c = αc + …" as printed would scale earlier samples down and lose energy); the step is
 // a fraction of the sampled level's voxel, and optionally the opacity is corrected for
 // it, α' = 1 − (1 − α)^(step / voxel width). A cone leaving the scene's bounding box (its
 // footprint wholly outside) stops. Ambient occlusion follows eq. 4:
