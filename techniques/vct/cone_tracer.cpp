@@ -310,7 +310,8 @@ GILAB_AVX2_INLINE PairCorners pair_corners_of(const ConeLevel& l, const Vec3& an
     _mm_storeu_si128(reinterpret_cast<__m128i*>(c.lower), _mm_add_epi32(row, _mm_shuffle_epi32(o0, 0)));
     _mm_storeu_si128(reinterpret_cast<__m128i*>(c.upper), _mm_add_epi32(row, _mm_shuffle_epi32(o1, 0)));
     const __m128i occ = _mm_mullo_epi32(t0, _mm_setr_epi32(1, int(l.occupancy_row), int(l.occupancy_slice), 0));
-    c.occupancy = _mm_cvtsi128_si32(_mm_add_epi32(_mm_add_epi32(occ, _mm_shuffle_epi32(occ, 1)), _mm_shuffle_epi32(occ, 2)));
+    c.occupancy =
+        _mm_cvtsi128_si32(_mm_add_epi32(_mm_add_epi32(occ, _mm_shuffle_epi32(occ, 1)), _mm_shuffle_epi32(occ, 2)));
     return c;
 }
 

@@ -14,9 +14,10 @@
 // marks empty reads nothing. Texels are RGBA16F (accel/vct/half_rgba.hpp), weighted four
 // channels at a time (SSE2), or two texels' eight at a time where the CPU has AVX2, F16C
 // and FMA (ConeKernel). Samples are composited front to back (eq. 3 on premultiplied
-// colour: c += (1 − α)·c₂, α += (1 − α)·α₂; the paper's "c = αc + …" as printed would scale earlier samples down and lose energy); the step is
-// a fraction of the sampled level's voxel, and optionally the opacity is corrected for
-// it, α' = 1 − (1 − α)^(step / voxel width). A cone leaving the scene's bounding box (its
+// colour: c += (1 − α)·c₂, α += (1 − α)·α₂; the paper's "c = αc + …" as printed would
+// scale earlier samples down and lose energy); the step is a fraction of the sampled
+// level's voxel, and optionally the opacity is corrected for it,
+// α' = 1 − (1 − α)^(step / voxel width). A cone leaving the scene's bounding box (its
 // footprint wholly outside) stops. Ambient occlusion follows eq. 4:
 // ao += (1 − ao)·α / (1 + λ·r), r the cone radius at the sample in finest-voxel units.
 //
