@@ -1,5 +1,6 @@
 #include "accel/dag/svdag.hpp"
 #include "accel/dag/child_mask.hpp"
+#include <bit>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_group.h>
@@ -22,6 +23,9 @@ public:
     uint32_t leaf_id() { return merger_.leaf_id(); }
     uint32_t bottom_id(uint8_t mask) { return merger_.bottom_id(mask); }
     uint32_t add_subtree(std::span<const uint64_t> codes, int top) { return merger_.add_subtree(codes, top); }
+    uint32_t add_subtree(std::span<const uint64_t> blocks, std::span<const uint64_t> masks, int top) {
+        return merger_.add_subtree(blocks, masks, top);
+    }
     void finish_top(int level, std::vector<uint64_t> codes, std::vector<uint32_t> ids) {
         merger_.finish_top(level, std::move(codes), std::move(ids));
     }
@@ -190,6 +194,22 @@ Svdag Svdag::from_voxels(const VoxelGrid& grid, std::span<const uint64_t> codes,
 
 Svdag Svdag::from_slices(const VoxelGrid& grid, int split_level, std::span<const uint64_t> cells,
                          const SliceSource& slice, const SvdagStreamOptions& options) {
+    grid.validate("SVDAG");
+    checked_split_level(grid, split_level);
+    return from_block_slices(
+        grid, split_level, cells,
+        [&](uint64_t cell) {
+            VoxelBlocks blocks;
+            const std::vector<uint64_t> codes = slice(cell);
+            check_voxel_codes(grid, codes, "SVDAG");
+            blocks_from_codes(codes, blocks.blocks, blocks.masks);
+            return blocks;
+        },
+        options);
+}
+
+Svdag Svdag::from_block_slices(const VoxelGrid& grid, int split_level, std::span<const uint64_t> cells,
+                               const BlockSliceSource& slice, const SvdagStreamOptions& options) {
     Stopwatch clock;
     grid.validate("SVDAG");
     checked_split_level(grid, split_level);
@@ -210,15 +230,22 @@ Svdag Svdag::from_slices(const VoxelGrid& grid, int split_level, std::span<const
                                      MemoryBudget::format(options.max_table_bytes));
         if (options.progress && c > 0) options.progress(c, cells.size());
         Stopwatch t;
-        std::vector<uint64_t> codes = slice(cells[c]);
+        const VoxelBlocks blocks = slice(cells[c]);
         slice_ms += t.elapsed_ms();
-        if (codes.empty()) continue;
-        check_voxel_codes(grid, codes, "SVDAG");
-        if ((codes.front() >> shift) != cells[c] || (codes.back() >> shift) != cells[c])
+        if (blocks.empty()) continue;
+        // Blocks ascending with a voxel each; the first and last voxel inside the cell
+        // (a block may hold several cells when the cells are smaller than 4³).
+        for (size_t i = 0; i < blocks.blocks.size(); ++i)
+            if (blocks.masks[i] == 0 || (i > 0 && blocks.blocks[i] <= blocks.blocks[i - 1]))
+                throw Error("SVDAG", "a slice's voxel blocks must be ascending and non-empty; block " + std::to_string(i) +
+                                         " is not");
+        const uint64_t first = blocks.blocks.front() << 6 | uint64_t(std::countr_zero(blocks.masks.front()));
+        const uint64_t last = blocks.blocks.back() << 6 | uint64_t(63 - std::countl_zero(blocks.masks.back()));
+        if ((first >> shift) != cells[c] || (last >> shift) != cells[c])
             throw Error("SVDAG", "a slice holds voxels outside its split cell " + std::to_string(cells[c]));
         top_codes.push_back(cells[c]);
-        top_ids.push_back(as.add_subtree(codes, split_level));
-        voxels += codes.size();
+        top_ids.push_back(as.add_subtree(blocks.blocks, blocks.masks, split_level));
+        voxels += blocks.voxel_count();
         ++dag.stats_.subtrees;
     }
     if (options.progress) options.progress(cells.size(), cells.size());
@@ -248,17 +275,17 @@ Svdag Svdag::from_voxelizer(const Voxelizer& voxelizer, int split_level, const S
     const size_t batch_cells = size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
     struct Batch {
         size_t begin = 0;
-        std::vector<std::vector<uint64_t>> codes;
-        bool holds(size_t i) const { return i >= begin && i < begin + codes.size(); }
+        std::vector<VoxelBlocks> cells;
+        bool holds(size_t i) const { return i >= begin && i < begin + cells.size(); }
     };
     auto voxelize_batch = [&](size_t begin, Batch& batch) {
         batch.begin = begin;
-        batch.codes.assign(std::min(batch_cells, cell_count - begin), {});
-        tbb::parallel_for(size_t(0), batch.codes.size(), [&](size_t i) {
+        batch.cells.assign(std::min(batch_cells, cell_count - begin), {});
+        tbb::parallel_for(size_t(0), batch.cells.size(), [&](size_t i) {
             VoxelRegion region;
             region.begin = morton_decode(bins.cells[begin + i]) << UVec3(uint32_t(cell_log2));
             region.end = region.begin + UVec3(1u << cell_log2);
-            batch.codes[i] = std::move(voxelizer.voxelize(region, bins.of(begin + i)).codes);
+            batch.cells[i] = voxelizer.voxelize_blocks(region, bins.of(begin + i));
         });
     };
     Batch current, upcoming;
@@ -277,8 +304,8 @@ Svdag Svdag::from_voxelizer(const Voxelizer& voxelizer, int split_level, const S
             }
         }
     } wait_on_exit{ahead, voxelizing_ahead};
-    size_t next = 0;  // from_slices asks for the cells in ascending order
-    return from_slices(
+    size_t next = 0;  // from_block_slices asks for the cells in ascending order
+    return from_block_slices(
         grid, split_level, bins.cells,
         [&](uint64_t cell) {
             while (bins.cells[next] != cell) ++next;
@@ -289,13 +316,13 @@ Svdag Svdag::from_voxelizer(const Voxelizer& voxelizer, int split_level, const S
                     std::swap(current, upcoming);
                 }
                 if (!current.holds(next)) voxelize_batch(next, current);
-                const size_t after = current.begin + current.codes.size();
+                const size_t after = current.begin + current.cells.size();
                 if (after < cell_count) {
                     voxelizing_ahead = true;
                     ahead.run([&, after] { voxelize_batch(after, upcoming); });
                 }
             }
-            return std::move(current.codes[next - current.begin]);
+            return std::move(current.cells[next - current.begin]);
         },
         options);
 }

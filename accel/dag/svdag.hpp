@@ -111,6 +111,10 @@ public:
 
 private:
     friend class SvdagAssembler;
+    // from_slices with each cell's voxels as blocks (the voxelizer's own form).
+    using BlockSliceSource = std::function<VoxelBlocks(uint64_t cell)>;
+    static Svdag from_block_slices(const VoxelGrid& grid, int split_level, std::span<const uint64_t> cells,
+                                   const BlockSliceSource& slice, const SvdagStreamOptions& options);
     VoxelGrid grid_;
     int depth_ = 0;
     std::vector<uint32_t> words_;

@@ -61,6 +61,23 @@ void SvdagMerger::merge_leaves(std::span<const uint64_t> codes, std::vector<uint
         out_codes.push_back(parent);
         masks_.push_back(mask);
     }
+    look_up_bottom(out_ids);
+}
+
+void SvdagMerger::merge_leaf_blocks(std::span<const uint64_t> blocks, std::span<const uint64_t> masks,
+                                    std::vector<uint64_t>& out_codes, std::vector<uint32_t>& out_ids) {
+    out_codes.clear();
+    masks_.clear();
+    for (size_t i = 0; i < blocks.size(); ++i)
+        for (int octant = 0; octant < 8; ++octant)
+            if (const uint8_t mask = uint8_t(masks[i] >> (8 * octant))) {
+                out_codes.push_back(blocks[i] << 3 | uint64_t(octant));
+                masks_.push_back(mask);
+            }
+    look_up_bottom(out_ids);
+}
+
+void SvdagMerger::look_up_bottom(std::vector<uint32_t>& out_ids) {
     Stopwatch lookup;
     out_ids.resize(masks_.size());
     for (size_t k = 0; k < masks_.size(); ++k) out_ids[k] = bottom_id(masks_[k]);
@@ -98,6 +115,16 @@ void SvdagMerger::merge_up(int level, const std::vector<uint64_t>& codes, const 
 uint32_t SvdagMerger::add_subtree(std::span<const uint64_t> codes, int top) {
     if (top == depth_) return leaf_id();
     merge_leaves(codes, codes_a_, ids_a_);
+    return merge_to(top);
+}
+
+uint32_t SvdagMerger::add_subtree(std::span<const uint64_t> blocks, std::span<const uint64_t> masks, int top) {
+    if (top == depth_) return leaf_id();
+    merge_leaf_blocks(blocks, masks, codes_a_, ids_a_);
+    return merge_to(top);
+}
+
+uint32_t SvdagMerger::merge_to(int top) {
     for (int l = depth_ - 1; l > top; --l) {
         merge_up(l, codes_a_, ids_a_, codes_b_, ids_b_);
         std::swap(codes_a_, codes_b_);

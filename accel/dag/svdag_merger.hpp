@@ -32,6 +32,9 @@ public:
     // Merges one subtree given by its ascending voxel codes up to level `top` and
     // returns its id there (the codes must all lie in one level-`top` cell).
     uint32_t add_subtree(std::span<const uint64_t> codes, int top);
+    // The same from the subtree's voxels as ascending 4³ blocks and their masks
+    // (core/voxel/voxelizer.hpp, VoxelBlocks): a mask's bytes are the lowest nodes' masks.
+    uint32_t add_subtree(std::span<const uint64_t> blocks, std::span<const uint64_t> masks, int top);
     // Nodes given on `level` (ascending codes, ids) merged up to the root; returns the
     // root's id on level 0 (kNoNode when there are none).
     uint32_t finish_top(int level, std::vector<uint64_t> codes, std::vector<uint32_t> ids);
@@ -51,6 +54,11 @@ public:
 
 private:
     void merge_leaves(std::span<const uint64_t> codes, std::vector<uint64_t>& out_codes, std::vector<uint32_t>& out_ids);
+    void merge_leaf_blocks(std::span<const uint64_t> blocks, std::span<const uint64_t> masks,
+                           std::vector<uint64_t>& out_codes, std::vector<uint32_t>& out_ids);
+    // Levels depth-1 .. top+1 of codes_a_/ids_a_ merged up to `top`.
+    uint32_t merge_to(int top);
+    void look_up_bottom(std::vector<uint32_t>& out_ids);
 
     std::vector<DagLevelTable>& tables_;
     int depth_;

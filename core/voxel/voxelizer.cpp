@@ -280,6 +280,32 @@ bool mask_reaches(const MaskedTriangle& m, int64_t x, int64_t y, int64_t z) {
 
 UVec3 VoxelList::voxel(size_t i) const { return morton_decode(codes[i]); }
 
+uint64_t VoxelBlocks::voxel_count() const {
+    uint64_t n = 0;
+    for (uint64_t m : masks) n += uint64_t(std::popcount(m));
+    return n;
+}
+
+std::vector<uint64_t> VoxelBlocks::codes() const {
+    std::vector<uint64_t> codes;
+    codes.reserve(voxel_count());
+    for (size_t i = 0; i < blocks.size(); ++i)
+        for (uint64_t m = masks[i]; m; m &= m - 1) codes.push_back(blocks[i] << 6 | uint64_t(std::countr_zero(m)));
+    return codes;
+}
+
+void blocks_from_codes(std::span<const uint64_t> codes, std::vector<uint64_t>& blocks, std::vector<uint64_t>& masks) {
+    blocks.clear();
+    masks.clear();
+    for (uint64_t code : codes) {
+        if (blocks.empty() || blocks.back() != code >> 6) {
+            blocks.push_back(code >> 6);
+            masks.push_back(0);
+        }
+        masks.back() |= uint64_t(1) << (code & 63);
+    }
+}
+
 void append_triangle_masks(const WorldMesh& mesh, const std::vector<Material>& materials, uint32_t first_triangle,
                            std::vector<TriangleMask>& out) {
     for (size_t t = 0; t < mesh.triangles.size(); ++t) {
@@ -311,7 +337,8 @@ struct Voxelizer::Impl {
 
     void init(std::span<const Vec3> positions, std::span<const UVec3> tris);
     // `subset`: indices of the triangles to voxelize (all when absent).
-    VoxelList run(VoxelRegion region, const std::span<const uint32_t>* subset = nullptr) const;
+    VoxelBlocks run(VoxelRegion region, const std::span<const uint32_t>* subset = nullptr) const;
+    VoxelList run_codes(const VoxelRegion& region, const std::span<const uint32_t>* subset = nullptr) const;
     uint64_t estimate_in(const VoxelRegion& region, const std::span<const uint32_t>* subset = nullptr) const;
 };
 
@@ -366,9 +393,20 @@ uint64_t Voxelizer::Impl::estimate_in(const VoxelRegion& region, const std::span
     return static_cast<uint64_t>(std::min(total, double(region.volume())));
 }
 
-VoxelList Voxelizer::Impl::run(VoxelRegion region, const std::span<const uint32_t>* subset) const {
+VoxelList Voxelizer::Impl::run_codes(const VoxelRegion& region, const std::span<const uint32_t>* subset) const {
     Stopwatch clock;
+    VoxelBlocks blocks = run(region, subset);
     VoxelList out;
+    out.grid = blocks.grid;
+    out.codes = blocks.codes();
+    out.stats = blocks.stats;
+    out.stats.ms = clock.elapsed_ms();
+    return out;
+}
+
+VoxelBlocks Voxelizer::Impl::run(VoxelRegion region, const std::span<const uint32_t>* subset) const {
+    Stopwatch clock;
+    VoxelBlocks out;
     out.grid = grid;
     region = region.intersect(grid.full_region());
     if (region.empty()) return out;
@@ -427,10 +465,10 @@ VoxelList Voxelizer::Impl::run(VoxelRegion region, const std::span<const uint32_
     out.stats.bricks = groups;
 
     // 2. Each brick: mark overlapped voxels in a bitmap indexed by local Morton code,
-    // then read it in order — sorted, unique output without a global sort.
+    // then read its words in order — each a 4³ block: sorted, unique output without a
+    // global sort.
     const size_t bitmap_words = std::max<size_t>(1, (size_t(1) << (3 * brick_log2)) / 64);
     BitmapPool pool(bitmap_words);
-    out.codes.reserve(estimated);
     auto fill_brick = [&](size_t g, std::vector<uint64_t>& bitmap, bool parallel) {
         const uint64_t key = pairs[group_begin[g]].brick;
         const UVec3 bc = morton_decode(key);
@@ -462,17 +500,23 @@ VoxelList Voxelizer::Impl::run(VoxelRegion region, const std::span<const uint32_
             run_range(group_begin[g], group_begin[g + 1], [&](uint64_t word, uint64_t bit) { bitmap[word] |= bit; });
         }
     };
-    auto drain = [&](size_t g, std::vector<uint64_t>& bitmap, std::vector<uint64_t>& codes) {
-        const uint64_t base = pairs[group_begin[g]].brick << (3 * brick_log2);
+    struct Blocks {
+        std::vector<uint64_t> blocks, masks;
+    };
+    auto drain = [&](size_t g, std::vector<uint64_t>& bitmap, Blocks& to) {
+        // A brick smaller than 4³ is a whole grid of at most 2³ voxels, whose one brick
+        // starts at code 0: its word is block 0 too.
+        const uint64_t first_block = (pairs[group_begin[g]].brick << (3 * brick_log2)) >> 6;
         for (size_t i = 0; i < bitmap.size(); ++i) {
-            uint64_t word = bitmap[i];
-            if (!word) continue;
+            if (!bitmap[i]) continue;
+            to.blocks.push_back(first_block | uint64_t(i));
+            to.masks.push_back(bitmap[i]);
             bitmap[i] = 0;  // leave the bitmap clean for reuse
-            while (word) {
-                codes.push_back(base | (uint64_t(i) << 6 | uint64_t(std::countr_zero(word))));
-                word &= word - 1;
-            }
         }
+    };
+    auto append = [&](Blocks& from) {
+        out.blocks.insert(out.blocks.end(), from.blocks.begin(), from.blocks.end());
+        out.masks.insert(out.masks.end(), from.masks.begin(), from.masks.end());
     };
 
     size_t g = 0;
@@ -481,14 +525,16 @@ VoxelList Voxelizer::Impl::run(VoxelRegion region, const std::span<const uint32_
         if (size >= kBigBrickTriangles) {
             auto bitmap = pool.take();
             fill_brick(g, bitmap, true);
-            drain(g, bitmap, out.codes);
+            Blocks blocks;
+            drain(g, bitmap, blocks);
+            append(blocks);
             pool.give(std::move(bitmap));
             ++g;
             continue;
         }
         size_t end = g;
         while (end < groups && end - g < kBatchBricks && group_begin[end + 1] - group_begin[end] < kBigBrickTriangles) ++end;
-        std::vector<std::vector<uint64_t>> results(end - g);
+        std::vector<Blocks> results(end - g);
         tbb::parallel_for(tbb::blocked_range<size_t>(g, end, 1), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t i = r.begin(); i < r.end(); ++i) {
                 auto bitmap = pool.take();
@@ -497,7 +543,7 @@ VoxelList Voxelizer::Impl::run(VoxelRegion region, const std::span<const uint32_
                 pool.give(std::move(bitmap));
             }
         });
-        for (auto& codes : results) out.codes.insert(out.codes.end(), codes.begin(), codes.end());
+        for (Blocks& blocks : results) append(blocks);
         g = end;
     }
     out.stats.box_tests = tests_total;
@@ -574,13 +620,24 @@ Voxelizer& Voxelizer::operator=(Voxelizer&&) noexcept = default;
 const VoxelGrid& Voxelizer::grid() const { return impl_->grid; }
 const VoxelizeOptions& Voxelizer::options() const { return impl_->options; }
 size_t Voxelizer::triangle_count() const { return impl_->triangles.size(); }
-VoxelList Voxelizer::voxelize() const { return impl_->run(impl_->grid.full_region()); }
-VoxelList Voxelizer::voxelize(const VoxelRegion& region) const { return impl_->run(region); }
-VoxelList Voxelizer::voxelize(const VoxelRegion& region, std::span<const uint32_t> triangles) const {
+VoxelList Voxelizer::voxelize() const { return impl_->run_codes(impl_->grid.full_region()); }
+VoxelList Voxelizer::voxelize(const VoxelRegion& region) const { return impl_->run_codes(region); }
+
+namespace {
+void check_triangle_indices(std::span<const uint32_t> triangles, size_t count) {
     for (uint32_t t : triangles)
-        if (t >= impl_->triangles.size())
+        if (t >= count)
             throw Error("voxelizer", "triangle " + std::to_string(t) + " does not exist (there are " +
-                                         std::to_string(impl_->triangles.size()) + ")");
+                                         std::to_string(count) + ")");
+}
+}  // namespace
+
+VoxelList Voxelizer::voxelize(const VoxelRegion& region, std::span<const uint32_t> triangles) const {
+    check_triangle_indices(triangles, impl_->triangles.size());
+    return impl_->run_codes(region, &triangles);
+}
+VoxelBlocks Voxelizer::voxelize_blocks(const VoxelRegion& region, std::span<const uint32_t> triangles) const {
+    check_triangle_indices(triangles, impl_->triangles.size());
     return impl_->run(region, &triangles);
 }
 uint64_t Voxelizer::estimate_voxels(const VoxelRegion& region) const {

@@ -74,6 +74,25 @@ struct VoxelList {
     UVec3 voxel(size_t i) const;
 };
 
+// The same voxels as 4³ blocks, the voxelizer's own form: the Morton code of each block
+// that holds a voxel (voxel code >> 6), ascending, and a mask of its voxels (bit i: the
+// voxel whose code ends in the six bits i). A surface fills several voxels of a block, so
+// this is several times smaller than the codes, and a mask's bytes are already the 2³
+// child masks a voxel octree's lowest nodes need.
+struct VoxelBlocks {
+    VoxelGrid grid;
+    std::vector<uint64_t> blocks;
+    std::vector<uint64_t> masks;  // never 0
+    VoxelizeStats stats;
+
+    bool empty() const { return blocks.empty(); }
+    uint64_t voxel_count() const;
+    std::vector<uint64_t> codes() const;  // the voxels' Morton codes, ascending
+};
+
+// Ascending voxel codes → blocks (the inverse of VoxelBlocks::codes).
+void blocks_from_codes(std::span<const uint64_t> codes, std::vector<uint64_t>& blocks, std::vector<uint64_t>& masks);
+
 class Voxelizer {
 public:
     // Triangles index `positions`. Throws Error for a bad grid (resolution 0 or above
@@ -99,6 +118,8 @@ public:
     // when they include every triangle that meets the region (a bin of bin_triangles over
     // the region's cell does), in time proportional to their count, not the scene's.
     VoxelList voxelize(const VoxelRegion& region, std::span<const uint32_t> triangles) const;
+    // The same voxels as blocks, without expanding them into codes.
+    VoxelBlocks voxelize_blocks(const VoxelRegion& region, std::span<const uint32_t> triangles) const;
 
     // Estimate of the occupied voxels inside a region: projected triangle areas plus
     // edge lengths, in voxels, capped by the region volume. On smooth meshes it is

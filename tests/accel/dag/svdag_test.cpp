@@ -129,7 +129,8 @@ TEST(Svdag, SplitBuildFromTheVoxelizerStreamsCells) {
     VoxelGrid g = gilab::test::unit_grid(200);  // depth 8, not a power of two
     Voxelizer vox(m.positions, m.triangles, g);
     Svdag whole = Svdag::from_svo(Svo::build(vox.voxelize()));
-    for (int split : {1, 3, 4}) {
+    // Split 7: cells of 2³ voxels, smaller than the voxelizer's 4³ blocks.
+    for (int split : {1, 3, 4, 7}) {
         Svdag dag = Svdag::from_voxelizer(vox, split);
         EXPECT_EQ(dag.level_node_counts(), whole.level_node_counts()) << "split level " << split;
         EXPECT_EQ(dag.decode(), whole.decode());

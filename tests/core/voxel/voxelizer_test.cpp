@@ -264,6 +264,37 @@ TEST(Voxelizer, BinnedCellsGiveTheWholeScenesVoxels) {
     EXPECT_THROW(vox.voxelize(g.full_region(), missing), Error);
 }
 
+// Blocks hold exactly the brute-force voxels, each block once with its voxels' bits,
+// also in grids smaller than one 4³ block and at a resolution that is no power of two.
+TEST(Voxelizer, BlocksAreTheVoxelsFourByFour) {
+    std::mt19937 rng(5);
+    TriangleSoup m = gilab::test::random_triangles(rng, 40, Vec3(0), Vec3(1));
+    std::vector<uint32_t> every(m.triangles.size());
+    for (uint32_t i = 0; i < every.size(); ++i) every[i] = i;
+    for (uint32_t res : {1u, 2u, 3u, 37u, 64u}) {
+        const VoxelGrid g = gilab::test::unit_grid(res);
+        const VoxelBlocks blocks = Voxelizer(m.positions, m.triangles, g).voxelize_blocks(g.full_region(), every);
+        const std::vector<uint64_t> expected = brute_force(m, g);
+        ASSERT_FALSE(expected.empty()) << res;
+        std::vector<uint64_t> expected_blocks, expected_masks;
+        for (uint64_t code : expected) {
+            if (expected_blocks.empty() || expected_blocks.back() != code / 64) {
+                expected_blocks.push_back(code / 64);
+                expected_masks.push_back(0);
+            }
+            expected_masks.back() |= uint64_t(1) << (code % 64);
+        }
+        EXPECT_EQ(blocks.blocks, expected_blocks) << res << "³";
+        EXPECT_EQ(blocks.masks, expected_masks) << res << "³";
+        EXPECT_EQ(blocks.voxel_count(), expected.size()) << res << "³";
+        EXPECT_EQ(blocks.codes(), expected) << res << "³";
+        std::vector<uint64_t> round_blocks, round_masks;
+        blocks_from_codes(expected, round_blocks, round_masks);
+        EXPECT_EQ(round_blocks, expected_blocks) << res << "³";
+        EXPECT_EQ(round_masks, expected_masks) << res << "³";
+    }
+}
+
 TEST(Voxelizer, BinningBeyondTheBudgetIsRefusedBeforeAllocating) {
     TriangleSoup m = gilab::test::uv_sphere(Vec3(0.5f), 0.45f);
     VoxelizeOptions small;
