@@ -142,6 +142,38 @@ inline bool overlaps_in_column(const PreparedTriangle& t, double bmin_w, const D
     return true;
 }
 
+// Narrows [a_begin, a_end], the columns of one row (centre v = center_v) along U, to
+// those the column axes may accept. Each axis's test is linear in the column index a;
+// the bounds are widened by two columns, far more than rounding can move them, so every
+// column left out fails `column_overlaps` too and the output is unchanged: the rows of
+// a large triangle's bounding box no longer visit the columns beside the triangle.
+template <int W>
+inline void row_span(const PreparedTriangle& t, double center_v, double s, double box, int64_t& a_begin,
+                     int64_t& a_end) {
+    constexpr int U = (W + 1) % 3, V = (W + 2) % 3;
+    constexpr double kSlack = 2.0;  // columns
+    double lo = double(a_begin), hi = double(a_end);
+    for (int i = 0; i < t.column_axes; ++i) {
+        const DVec3& axis = t.axis[i];
+        const double slope = axis[U] * s;  // change of the centre's projection per column
+        if (!(std::abs(slope) >= 1e-6 * (std::abs(axis[U]) + std::abs(axis[V])) * s)) continue;
+        // Column a's centre projects to base + slope·a (centre u = (a + ½)·s); the axis
+        // accepts it while that lies in [amin − r, amax + r].
+        const double base = axis[U] * 0.5 * s + axis[V] * center_v;
+        const double r = t.radius[i] * box;
+        double from = (t.amin[i] - r - base) / slope, to = (t.amax[i] + r - base) / slope;
+        if (slope < 0) std::swap(from, to);
+        lo = std::max(lo, std::floor(from - kSlack));
+        hi = std::min(hi, std::ceil(to + kSlack));
+    }
+    if (lo > hi) {
+        a_end = a_begin - 1;
+        return;
+    }
+    a_begin = int64_t(lo);
+    a_end = int64_t(hi);
+}
+
 // The planar case of `rasterize`: candidates per column of the projection along W come
 // from the plane's height range over the column.
 template <int W, class Emit>
@@ -152,18 +184,27 @@ void rasterize_columns(const PreparedTriangle& t, const int64_t (&lo)[3], const 
     const double inv = 1.0 / s;
     const double box = s + 2 * pad;
     int64_t cell[3];
+    const double w_floor = double(lo[W] - 1), w_ceiling = double(hi[W] + 1);  // lo[W] ≥ 0
+    const int64_t w_top = hi[W] + 3;
     for (int64_t b = lo[V]; b <= hi[V]; ++b) {
         double v0 = double(b) * s - pad, v1 = double(b + 1) * s + pad;
         double hv_min = t.cv >= 0 ? t.cv * v0 : t.cv * v1;
         double hv_max = t.cv >= 0 ? t.cv * v1 : t.cv * v0;
-        for (int64_t a = lo[U]; a <= hi[U]; ++a) {
+        int64_t a_begin = lo[U], a_end = hi[U];
+        row_span<W>(t, (double(b) + 0.5) * s, s, box, a_begin, a_end);
+        for (int64_t a = a_begin; a <= a_end; ++a) {
             double u0 = double(a) * s - pad, u1 = double(a + 1) * s + pad;
             double zmin = t.c0 + hv_min + (t.cu >= 0 ? t.cu * u0 : t.cu * u1);
             double zmax = t.c0 + hv_max + (t.cu >= 0 ? t.cu * u1 : t.cu * u0);
             zmin = std::max(zmin, t.lo[W]) - pad;
             zmax = std::min(zmax, t.hi[W]) + pad;
-            int64_t k0 = std::max(lo[W], clamp_to_index(std::ceil(zmin * inv - 1.0 - kEps), lo[W] - 1, hi[W] + 1));
-            int64_t k1 = std::min(hi[W], clamp_to_index(std::floor(zmax * inv + kEps), lo[W] - 1, hi[W] + 1));
+            // Ceiling and floor by truncating values shifted to be positive: the shift
+            // rounds by far less than kEps, so it can only move a bound across a box that
+            // the plane misses by kEps, which the exact test rejects anyway.
+            const double x0 = std::clamp(zmin * inv - 1.0 - kEps, w_floor, w_ceiling);
+            const double x1 = std::clamp(zmax * inv + kEps, w_floor, w_ceiling);
+            int64_t k0 = std::max(lo[W], w_top - int64_t(double(w_top) - x0));
+            int64_t k1 = std::min(hi[W], int64_t(x1 + 2.0) - 2);
             if (k0 > k1) continue;
             // Every candidate counts as a box test, as when each was tested whole.
             tests += uint64_t(k1 - k0 + 1);
