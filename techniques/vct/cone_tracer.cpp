@@ -130,14 +130,23 @@ struct ClipGeometry {
     float s[3][2];  // n[a] × the voxel centre's coordinate a, for the lower and upper voxel
     float half;
 };
+[[gnu::always_inline]] inline float clip_half_width(const ConeLevel& l, const Vec4& plane) {
+    return 0.501f * l.voxel_size * (std::abs(plane.x) + std::abs(plane.y) + std::abs(plane.z));
+}
+// n[a] × the coordinate a of voxel i's centre: one float, or four lanes (GCC and Clang
+// vector types take the same operators), so both kernels compute it alike.
+template <class T>
+[[gnu::always_inline]] inline T clip_centre_term(T n, T anchor, T i, T voxel_size, T half) {
+    return n * (anchor + (i + half) * voxel_size);
+}
 [[gnu::always_inline]] inline ClipGeometry clip_geometry(const ConeLevel& l, const Vec3& anchor, const SampleCorners& c,
                                                          const Vec4& plane) {
     ClipGeometry g;
-    const Vec3 n(plane);
-    g.half = 0.501f * l.voxel_size * (std::abs(n.x) + std::abs(n.y) + std::abs(n.z));
+    g.half = clip_half_width(l, plane);
     const IVec3 i[2] = {c.i0, c.i1};
     for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 2; ++b) g.s[a][b] = n[a] * (anchor[a] + (float(i[b][a]) + 0.5f) * l.voxel_size);
+        for (int b = 0; b < 2; ++b)
+            g.s[a][b] = clip_centre_term(plane[a], anchor[a], float(i[b][a]), l.voxel_size, 0.5f);
     return g;
 }
 // Whether a face (2a looks along +a, 2a + 1 along −a: anisotropic_voxel.hpp) is turned
@@ -333,12 +342,11 @@ GILAB_AVX2_INLINE Vec4 sample_avx2_inline(const ConeLevel& l, const Vec3& anchor
         const __m128 n = _mm_setr_ps(plane->x, plane->y, plane->z, 0.0f);
         const __m128 anc = _mm_setr_ps(anchor.x, anchor.y, anchor.z, 0.0f), vs = _mm_set1_ps(l.voxel_size);
         const __m128 h = _mm_set1_ps(0.5f);
-        const __m128 s0 = _mm_mul_ps(n, _mm_add_ps(anc, _mm_mul_ps(_mm_add_ps(_mm_cvtepi32_ps(c.i0), h), vs)));
-        const __m128 s1 = _mm_mul_ps(n, _mm_add_ps(anc, _mm_mul_ps(_mm_add_ps(_mm_cvtepi32_ps(c.i1), h), vs)));
+        const __m128 s0 = clip_centre_term(n, anc, _mm_cvtepi32_ps(c.i0), vs, h);
+        const __m128 s1 = clip_centre_term(n, anc, _mm_cvtepi32_ps(c.i1), vs, h);
         const Texels8 s = spread(s0, s1);
         const __m256 d = _mm256_sub_ps(_mm256_add_ps(_mm256_add_ps(s.x, s.y), s.z), _mm256_set1_ps(plane->w));
-        const __m256 half =
-            _mm256_set1_ps(0.501f * l.voxel_size * (std::abs(plane->x) + std::abs(plane->y) + std::abs(plane->z)));
+        const __m256 half = _mm256_set1_ps(clip_half_width(l, *plane));
         const __m256 front = _mm256_and_ps(weight, _mm256_cmp_ps(_mm256_add_ps(d, half), zero, _CMP_GT_OQ));
         const __m256 back = _mm256_and_ps(weight, _mm256_cmp_ps(_mm256_sub_ps(d, half), zero, _CMP_GT_OQ));
         __m256 face_weight[3];

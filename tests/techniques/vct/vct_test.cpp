@@ -247,6 +247,44 @@ TEST(ConeTracer, KernelsAgree) {
     }
 }
 
+// Levels above 512³ voxels take the portable sampler under the AVX2 kernel (its 32-bit
+// cells would not hold them): there the two kernels agree bit for bit, while on a level
+// of 512³ over the same texels the AVX2 sums, rounded otherwise, differ somewhere.
+TEST(ConeTracer, LevelsAbove512TakeThePortableSampler) {
+    if (best_cone_kernel() != ConeKernel::avx2) GTEST_SKIP() << "this CPU lacks AVX2, FMA or F16C: one kernel only";
+    constexpr int kStored = 16;  // a toroidal store of 16³ texels behind a larger region
+    std::vector<HalfRGBA> texels(size_t(kStored) * kStored * kStored * kFaceCount);
+    Rng rng(3, 1);
+    for (HalfRGBA& t : texels)
+        t = to_half_rgba(Vec4(rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform()));
+    auto view_of = [&](int size) {
+        ConeLevel l;
+        l.data = texels.data();
+        l.x_stride = kFaceCount;
+        l.row_stride = size_t(kStored) * kFaceCount;
+        l.slice_stride = size_t(kStored) * kStored * kFaceCount;
+        l.size = size;
+        l.wrap_mask = kStored - 1;
+        return VoxelConeView::of_levels(Vec3(0.0f), true, {l});
+    };
+    for (int size : {512, 513, 4096}) {
+        const VoxelConeView view = view_of(size);
+        int differing = 0;
+        for (int i = 0; i < 2000; ++i) {
+            const Vec3 p = Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * float(size);
+            const Vec3 d = glm::normalize(Vec3(rng.uniform(), rng.uniform(), rng.uniform()) - Vec3(0.5f) + Vec3(1e-3f));
+            const Vec4 plane(d, glm::dot(d, p) - (rng.uniform() - 0.25f));
+            for (const Vec4* clip : {static_cast<const Vec4*>(nullptr), &plane})
+                differing += view.sample_level(0, p, faces_seen_along(d), clip, ConeKernel::portable) !=
+                             view.sample_level(0, p, faces_seen_along(d), clip, ConeKernel::avx2);
+        }
+        if (size > 512)
+            EXPECT_EQ(differing, 0) << size << "³";
+        else
+            EXPECT_GT(differing, 0) << "at 512³ the AVX2 sampler runs and rounds otherwise";
+    }
+}
+
 // ---------------------------------------------------------------------------------
 
 // The Cornell box's diffuse indirect against the path tracer's indirect with the same
