@@ -194,8 +194,6 @@ Svdag Svdag::from_voxels(const VoxelGrid& grid, std::span<const uint64_t> codes,
 
 Svdag Svdag::from_slices(const VoxelGrid& grid, int split_level, std::span<const uint64_t> cells,
                          const SliceSource& slice, const SvdagStreamOptions& options) {
-    grid.validate("SVDAG");
-    checked_split_level(grid, split_level);
     return from_block_slices(
         grid, split_level, cells,
         [&](uint64_t cell) {
