@@ -3,9 +3,10 @@
 // with the technique's default shadows. Counters: rays per second and nodes entered per
 // primary ray. The DAG is built once per scene (two frames at 512³) and kept.
 //
-// Then the symmetry-aware DAG against the SVDAG it is built from: frame 0 of a scene on
-// a grid around it, the same primary rays from the scene camera cast with cast_dag_ray
-// and cast_ssvdag_ray (no shading), and the two DAGs' nodes and bytes.
+// Then the symmetry-aware DAGs against the SVDAG they are built from: frame 0 of a scene
+// on a grid around it, the same primary rays from the scene camera cast with cast_dag_ray
+// and cast_symmetric_dag_ray through the SSVDAG (reflections) and the cube-symmetric DAG
+// (reflections and axis permutations), no shading, and the DAGs' nodes and bytes.
 #include <benchmark/benchmark.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -18,8 +19,8 @@
 #include <string>
 #include <vector>
 #include "accel/dag/dag_ray_caster.hpp"
-#include "accel/dag/ssvdag.hpp"
-#include "accel/dag/ssvdag_ray_caster.hpp"
+#include "accel/dag/symmetric_dag.hpp"
+#include "accel/dag/symmetric_dag_ray_caster.hpp"
 #include "accel/dag/svdag.hpp"
 #include "core/io/asset_paths.hpp"
 #include "core/scene/camera.hpp"
@@ -83,10 +84,11 @@ void sizes(benchmark::internal::Benchmark* b) {
     b->Args({400, 300})->Args({1024, 768})->Unit(benchmark::kMillisecond)->UseRealTime();
 }
 
-// Frame 0 of a scene as an SVDAG and the SSVDAG made from it, with the scene's camera.
+// Frame 0 of a scene as an SVDAG and the symmetric DAGs made from it, with the scene's camera.
 struct SymmetryDags {
     Svdag svdag;
     Ssvdag ssvdag;
+    CubeSymmetricDag cube;
     SceneCamera camera;
 };
 
@@ -105,6 +107,7 @@ SymmetryDags* symmetry_dags(const std::string& name, uint32_t resolution) {
         d = std::make_unique<SymmetryDags>();
         d->svdag = Svdag::from_voxelizer(voxelizer, std::max(0, voxelizer.grid().depth() - 8));
         d->ssvdag = Ssvdag::from_svdag(d->svdag);
+        d->cube = CubeSymmetricDag::from_svdag(d->svdag);
         d->camera = scene.camera.value_or(default_camera_for(frame.bounds));
     } catch (const std::exception&) {
         d.reset();
@@ -112,8 +115,10 @@ SymmetryDags* symmetry_dags(const std::string& name, uint32_t resolution) {
     return (cache[key] = std::move(d)).get();
 }
 
-// Args: resolution, image width, height. The same rays through either DAG, on all threads.
-template <bool kSymmetric>
+enum class DagKind { svdag, ssvdag, cube };
+
+// Args: resolution, image width, height. The same rays through one of the DAGs, on all threads.
+template <DagKind kKind>
 void cast_symmetry(benchmark::State& state, const std::string& name) {
     SymmetryDags* d = symmetry_dags(name, uint32_t(state.range(0)));
     if (!d) {
@@ -135,7 +140,9 @@ void cast_symmetry(benchmark::State& state, const std::string& name) {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
             uint64_t v = 0, h = 0;
             for (size_t i = r.begin(); i < r.end(); ++i) {
-                const VoxelRayHit hit = kSymmetric ? cast_ssvdag_ray(d->ssvdag, rays[i]) : cast_dag_ray(view, rays[i]);
+                const VoxelRayHit hit = kKind == DagKind::ssvdag ? cast_symmetric_dag_ray(d->ssvdag, rays[i])
+                                        : kKind == DagKind::cube ? cast_symmetric_dag_ray(d->cube, rays[i])
+                                                                 : cast_dag_ray(view, rays[i]);
                 v += hit.nodes_visited;
                 h += hit.hit;
             }
@@ -148,14 +155,19 @@ void cast_symmetry(benchmark::State& state, const std::string& name) {
     state.counters["nodes_per_ray"] = double(visits) / double(rays.size());
     state.counters["hit_fraction"] = double(hits) / double(rays.size());
     state.counters["threads"] = double(tbb::this_task_arena::max_concurrency());
-    state.counters["dag_bytes"] = double(kSymmetric ? d->ssvdag.bytes() : d->svdag.bytes());
-    state.counters["dag_nodes"] = double(kSymmetric ? d->ssvdag.node_count() : d->svdag.node_count());
+    state.counters["dag_bytes"] = double(kKind == DagKind::ssvdag ? d->ssvdag.bytes()
+                                         : kKind == DagKind::cube ? d->cube.bytes()
+                                                                  : d->svdag.bytes());
+    state.counters["dag_nodes"] = double(kKind == DagKind::ssvdag ? d->ssvdag.node_count()
+                                         : kKind == DagKind::cube ? d->cube.node_count()
+                                                                  : d->svdag.node_count());
 }
 
-void cast_svdag(benchmark::State& state, const std::string& name) { cast_symmetry<false>(state, name); }
-void cast_ssvdag(benchmark::State& state, const std::string& name) { cast_symmetry<true>(state, name); }
+void cast_svdag(benchmark::State& state, const std::string& name) { cast_symmetry<DagKind::svdag>(state, name); }
+void cast_ssvdag(benchmark::State& state, const std::string& name) { cast_symmetry<DagKind::ssvdag>(state, name); }
+void cast_cube_dag(benchmark::State& state, const std::string& name) { cast_symmetry<DagKind::cube>(state, name); }
 
-// Nodes and bytes of both DAGs (arg: resolution); the time is the SVDAG → SSVDAG conversion.
+// Nodes and bytes of the DAGs (arg: resolution); the time is the SVDAG → SSVDAG conversion.
 void ssvdag_size(benchmark::State& state, const std::string& name) {
     SymmetryDags* d = symmetry_dags(name, uint32_t(state.range(0)));
     if (!d) {
@@ -172,8 +184,13 @@ void ssvdag_size(benchmark::State& state, const std::string& name) {
     state.counters["ssvdag_bytes"] = double(d->ssvdag.bytes());
     state.counters["bytes_ratio"] = double(d->ssvdag.bytes()) / double(d->svdag.bytes());
     state.counters["ssvdag_word_bytes"] = double(d->ssvdag.word_bytes());
-    state.counters["mirrored_pointers"] = double(d->ssvdag.mirrored_pointer_count());
+    state.counters["mirrored_pointers"] = double(d->ssvdag.transformed_pointer_count());
     state.counters["long_pointers"] = double(d->ssvdag.long_pointer_count());
+    state.counters["cube_nodes"] = double(d->cube.node_count());
+    state.counters["cube_bytes"] = double(d->cube.bytes());
+    state.counters["cube_over_ssvdag_bytes"] = double(d->cube.bytes()) / double(d->ssvdag.bytes());
+    state.counters["cube_permuting_pointers"] = double(d->cube.permuting_pointer_count());
+    state.counters["cube_long_pointers"] = double(d->cube.long_pointer_count());
     state.counters["voxels"] = double(d->ssvdag.voxel_count());
 }
 
@@ -189,8 +206,10 @@ BENCHMARK_CAPTURE(cast, fire, std::string("fire"))->Apply(sizes);
 
 BENCHMARK_CAPTURE(cast_svdag, kitchen, std::string("kitchen"))->Apply(symmetry_sizes);
 BENCHMARK_CAPTURE(cast_ssvdag, kitchen, std::string("kitchen"))->Apply(symmetry_sizes);
+BENCHMARK_CAPTURE(cast_cube_dag, kitchen, std::string("kitchen"))->Apply(symmetry_sizes);
 BENCHMARK_CAPTURE(cast_svdag, sponza, std::string("sponza"))->Apply(symmetry_sizes);
 BENCHMARK_CAPTURE(cast_ssvdag, sponza, std::string("sponza"))->Apply(symmetry_sizes);
+BENCHMARK_CAPTURE(cast_cube_dag, sponza, std::string("sponza"))->Apply(symmetry_sizes);
 // The bunny mesh alone (the bunny scene adds a ground six times its size).
 BENCHMARK_CAPTURE(ssvdag_size, bunny, std::string("bunny/stanford-bunny.obj"))
     ->Arg(512)->Arg(1024)->Arg(2048)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);

@@ -1,6 +1,6 @@
 #pragma once
 // The first-hit octree walk of Laine & Karras 2010 (ESVO, appendix) shared by the DAG ray
-// casters (dag_ray_caster.hpp, ssvdag_ray_caster.hpp): single precision in the [1,2]³
+// casters (dag_ray_caster.hpp, symmetric_dag_ray_caster.hpp): single precision in the [1,2]³
 // cube, the ray mirrored so that it runs towards −x, −y, −z, children entered front to
 // back with no sorting, a step to a neighbour one comparison per axis, and a pop that
 // finds the ancestor to resume from the highest differing bit of the position.
@@ -10,13 +10,19 @@
 //   uint32_t mask(DagWalkNode node, bool voxel_parent) const;   // 8-bit child mask
 //   DagWalkNode child(DagWalkNode node, uint32_t mask, uint32_t stored_slot, int level) const;
 // voxel_parent: the node's children are voxels; level: the node's, 0 at the root. A node
-// may be stored reflected (SSVDAG):
-// `child` returns the pointer's own mirror, and the walk composes the mirrors along the
-// path, so the cell in slot k of a node seen through mirror m is its stored slot k ^ m.
-// Formats without mirrors return 0, which the compiler folds away.
+// may be stored transformed (symmetric_dag.hpp): `child` returns the pointer's own
+// transform, and the walk composes the transforms along the path. A format whose
+// transforms are more than reflections gives the group's rules as well:
+//   static uint32_t compose(uint32_t a, uint32_t b);            // b first, then a
+//   static uint32_t source_slot(uint32_t transform, uint32_t slot);
+// (the stored slot holding the cell in `slot` of a node seen through `transform`).
+// Without them transforms are 3-bit mirrors: composing is XOR and the cell in slot k of
+// a node seen through mirror m is its stored slot k ^ m. Formats without transforms
+// return 0, which the compiler folds away.
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <concepts>
 #include <cstdint>
 #include "accel/dag/voxel_ray_traversal.hpp"
 
@@ -24,10 +30,25 @@ namespace gilab {
 
 struct DagWalkNode {
     uint32_t address = 0;
-    uint32_t mirror = 0;  // bit a: reflected along axis a
+    uint32_t transform = 0;  // for mirrors, bit a: reflected along axis a
 };
 
 namespace dag_walk {
+template <class Nodes>
+concept HasGroupRules = requires(uint32_t t) {
+    { Nodes::compose(t, t) } -> std::convertible_to<uint32_t>;
+    { Nodes::source_slot(t, t) } -> std::convertible_to<uint32_t>;
+};
+template <class Nodes>
+inline uint32_t compose(uint32_t a, uint32_t b) {
+    if constexpr (HasGroupRules<Nodes>) return Nodes::compose(a, b);
+    else return a ^ b;
+}
+template <class Nodes>
+inline uint32_t source_slot(uint32_t transform, uint32_t slot) {
+    if constexpr (HasGroupRules<Nodes>) return Nodes::source_slot(transform, slot);
+    else return slot ^ transform;
+}
 // Positions live in [1,2), where a float's mantissa bit k stands for a cell of size
 // 2^(k − 23): scale k is the level whose cells have that size.
 inline constexpr int kMaxScale = 23;
@@ -79,7 +100,7 @@ VoxelRayHit walk_dag_ray(const Nodes& nodes, const VoxelGrid& grid, int depth, c
     }
 
     struct StackEntry {
-        DagWalkNode parent;  // with the mirror composed from the root
+        DagWalkNode parent;  // with the transform composed from the root
         float t_max;
     };
     const int voxel_scale = kMaxScale - depth;
@@ -96,7 +117,7 @@ VoxelRayHit walk_dag_ray(const Nodes& nodes, const VoxelGrid& grid, int depth, c
     while (scale < kMaxScale) {
         const float tc[3] = {pos[0] * coef[0] - bias[0], pos[1] * coef[1] - bias[1], pos[2] * coef[2] - bias[2]};
         const float tc_max = std::min({tc[0], tc[1], tc[2]});  // where the ray leaves the child
-        const uint32_t stored_slot = idx ^ ray_mirror ^ parent.mirror;
+        const uint32_t stored_slot = source_slot<Nodes>(parent.transform, idx ^ ray_mirror);
         if ((mask >> stored_slot) & 1u) {
             const float tv_max = std::min(t_max, tc_max);
             if (t_min <= tv_max) {
@@ -115,7 +136,7 @@ VoxelRayHit walk_dag_ray(const Nodes& nodes, const VoxelGrid& grid, int depth, c
                 // Push: descend into the child, remembering where to resume.
                 stack[scale] = {parent, t_max};
                 const DagWalkNode child = nodes.child(parent, mask, stored_slot, kMaxScale - 1 - scale);
-                parent = {child.address, parent.mirror ^ child.mirror};
+                parent = {child.address, compose<Nodes>(parent.transform, child.transform)};
                 const float half = scale_exp2 * 0.5f;
                 --scale;
                 scale_exp2 = half;

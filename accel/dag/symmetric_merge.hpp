@@ -1,8 +1,8 @@
 #pragma once
 // An SVDAG's subtrees that are equal up to a node symmetry (node_symmetry.hpp) merged
-// into one, level by level from the voxels' parents up. The SSVDAG stores the result for
-// the reflections (ssvdag.hpp); for the 48 cube symmetries it is counted (what axis
-// permutations would save on top of the reflections).
+// into one, level by level from the voxels' parents up. SymmetricDag (symmetric_dag.hpp)
+// stores the result: the SSVDAG for the 8 reflections, the cube-symmetric DAG for all 48
+// symmetries of the cube.
 //
 // Each node is keyed as (mask, then (child id, child transform) per non-empty slot in
 // slot order) under every symmetry t of the group; the smallest key is kept, and the node

@@ -6,11 +6,10 @@
 #include <algorithm>
 #include <optional>
 #include <string>
-#include <unordered_set>
 #include <vector>
 #include "accel/dag/dag_ray_caster.hpp"
-#include "accel/dag/ssvdag.hpp"
-#include "accel/dag/ssvdag_ray_caster.hpp"
+#include "accel/dag/symmetric_dag.hpp"
+#include "accel/dag/symmetric_dag_ray_caster.hpp"
 #include "accel/dag/svdag.hpp"
 #include "core/scene/camera.hpp"
 #include "core/util/error.hpp"
@@ -19,6 +18,7 @@
 #include "core/voxel/voxelizer.hpp"
 #include "experiments/p2_dag/dag_models.hpp"
 #include "experiments/p2_dag/streamed_svdag_row.hpp"
+#include "experiments/p2_dag/symmetric_dag_checks.hpp"
 #include "experiments/runner/experiment.hpp"
 #include "experiments/runner/measures.hpp"
 #include "experiments/runner/spec_functions.hpp"
@@ -54,103 +54,6 @@ uint64_t svdag_bytes_with_packed_leaves(const Svdag& dag) {
     const uint64_t parent_and_leaf_words = words - first_parent;  // level depth-1, then the one leaf word
     const uint64_t packed_words = (dag.level_node_counts()[size_t(depth - 1)] + 3) / 4;
     return (words - parent_and_leaf_words + packed_words) * sizeof(uint32_t);
-}
-
-// Whether the SSVDAG holds the SVDAG's octree: both walked from the root together, the
-// child masks compared at every pair of nodes met (equal masks everywhere = equal voxels).
-// Each SVDAG node is walked once per SSVDAG pointer it meets, so the walk costs the size
-// of the DAGs, not the voxel count: it checks rows far too large to decode.
-bool same_octree(const Svdag& svdag, const Ssvdag& ssvdag) {
-    if (svdag.empty() || ssvdag.empty()) return svdag.empty() == ssvdag.empty();
-    if (svdag.depth() != ssvdag.depth()) return false;
-    const int depth = svdag.depth();
-    if (depth == 0) return ssvdag.voxel_count() == 1;
-    // First pointer met per SVDAG word (a pointer word, never all ones: that would be
-    // mirror 7 at the last of 2^29 addresses); further ones in `more`.
-    constexpr uint32_t kUnseen = 0xffffffffu;
-    std::vector<uint32_t> first(svdag.words().size(), kUnseen);
-    std::unordered_set<uint64_t> more;
-    auto first_visit = [&](uint32_t node, const SsvdagPointer& p) {
-        const uint32_t word = p.mirror << kSsvdagMirrorShift | p.address;
-        if (first[node] == kUnseen) {
-            first[node] = word;
-            return true;
-        }
-        return first[node] != word && more.insert(uint64_t(node) << 32 | word).second;
-    };
-    struct Pair {
-        uint32_t node;
-        SsvdagPointer pointer;
-        int level;
-    };
-    std::vector<Pair> stack{{svdag.root(), ssvdag.root(), 0}};
-    while (!stack.empty()) {
-        const Pair p = stack.back();
-        stack.pop_back();
-        const uint8_t mask = svdag.mask(p.node);
-        if (mask != ssvdag.mask(p.pointer, p.level)) return false;
-        if (p.level == depth - 1) continue;  // the children are voxels
-        for (int slot = 0; slot < 8; ++slot) {
-            if (!(mask & (1u << slot))) continue;
-            const uint32_t child = svdag.child(p.node, slot);
-            const std::optional<SsvdagPointer> mirrored = ssvdag.child(p.pointer, p.level, slot);
-            if (!mirrored) return false;
-            if (first_visit(child, *mirrored)) stack.push_back({child, *mirrored, p.level + 1});
-        }
-    }
-    return true;
-}
-
-// One ray per pixel centre of a size² image from the scene camera.
-std::vector<Ray> camera_rays(const Model& model, int size) {
-    const SceneCamera& c = model.camera;
-    const EyeCamera camera = EyeCamera::look_at(c.position, c.target, c.up, c.vertical_fov_degrees, size, size);
-    std::vector<Ray> rays;
-    rays.reserve(size_t(size) * size_t(size));
-    for (int y = 0; y < size; ++y)
-        for (int x = 0; x < size; ++x) rays.push_back(camera.generate_ray(float(x) + 0.5f, float(y) + 0.5f));
-    return rays;
-}
-
-// Every ray cast once through a DAG on all threads; returns rays per second.
-template <class Cast>
-double cast_all(const std::vector<Ray>& rays, std::vector<VoxelRayHit>& hits, Cast cast) {
-    hits.resize(rays.size());
-    Stopwatch watch;
-    parallel_for(rays.size(), 256, [&](size_t begin, size_t end) {
-        for (size_t i = begin; i < end; ++i) hits[i] = cast(rays[i]);
-    });
-    return double(rays.size()) / (watch.elapsed_ms() * 1e-3);
-}
-
-struct RayFigures {
-    size_t rays = 0;
-    double hit_fraction = 0;
-    double svdag_rays_per_s = 0, ssvdag_rays_per_s = 0;
-    uint64_t disagreeing = 0;  // rays whose hit or hit voxel differs between the two
-};
-
-// The same rays through both DAGs, `reps` times each, alternating so that a change in
-// the machine's load hits both alike; rates are medians.
-RayFigures cast_both(const Svdag& svdag, const Ssvdag& ssvdag, const std::vector<Ray>& rays, int reps) {
-    const DagWordsView view = dag_view(svdag);
-    std::vector<VoxelRayHit> a, b;
-    std::vector<double> rate_a, rate_b;
-    for (int r = 0; r < reps; ++r) {
-        rate_a.push_back(cast_all(rays, a, [&](const Ray& ray) { return cast_dag_ray(view, ray); }));
-        rate_b.push_back(cast_all(rays, b, [&](const Ray& ray) { return cast_ssvdag_ray(ssvdag, ray); }));
-    }
-    RayFigures f;
-    f.rays = rays.size();
-    f.svdag_rays_per_s = median(rate_a);
-    f.ssvdag_rays_per_s = median(rate_b);
-    uint64_t hits = 0;
-    for (size_t i = 0; i < rays.size(); ++i) {
-        hits += a[i].hit;
-        f.disagreeing += a[i].hit != b[i].hit || (a[i].hit && a[i].voxel != b[i].voxel);
-    }
-    f.hit_fraction = rays.empty() ? 0.0 : double(hits) / double(rays.size());
-    return f;
 }
 
 double seconds_of(const Stopwatch& watch) { return watch.elapsed_ms() * 1e-3; }
@@ -220,7 +123,13 @@ void measure_scale(const ProbeCall& call, const Model& model, ProbeOutput& out) 
         const std::vector<Ray> rays = camera_rays(model, call.size);
         ctx.say(row_name + ": casting " + std::to_string(rays.size()) + " rays ×" + std::to_string(ray_reps) +
                 " through each DAG");
-        const RayFigures rf = cast_both(svdag, ssvdag, rays, ray_reps);
+        const DagWordsView view = dag_view(svdag);
+        const std::vector<RayRun> runs =
+            cast_in_turn(rays, ray_reps,
+                         {[&](const Ray& ray) { return cast_dag_ray(view, ray); },
+                          [&](const Ray& ray) { return cast_symmetric_dag_ray(ssvdag, ray); }});
+        const double svdag_rays_per_s = runs[0].median_rays_per_s(), ssvdag_rays_per_s = runs[1].median_rays_per_s();
+        const uint64_t disagreeing = disagreeing_rays(runs[0], runs[1]);
 
         const double svdag_bytes = double(svdag.bytes()), ssvdag_bytes = double(ssvdag.bytes());
         const double ssvdag_word_bytes = double(ssvdag.word_bytes());
@@ -242,7 +151,7 @@ void measure_scale(const ProbeCall& call, const Model& model, ProbeOutput& out) 
              {"ssvdag_words_MB", mb(ssvdag_word_bytes)},
              {"ssvdag_words_over_packed_leaves", ratio(ssvdag_word_bytes, packed_bytes)},
              {"ssvdag_over_ssvdag_words", ratio(ssvdag_bytes, ssvdag_word_bytes)},
-             {"mirrored_pointer_share", ratio(double(ssvdag.mirrored_pointer_count()), double(ssvdag.pointer_count()))},
+             {"mirrored_pointer_share", ratio(double(ssvdag.transformed_pointer_count()), double(ssvdag.pointer_count()))},
              {"long_pointer_share", ratio(double(ssvdag.long_pointer_count()), double(ssvdag.pointer_count()))},
              {"bits_per_voxel_svdag", ratio(8 * svdag_bytes, voxel_count)},
              {"bits_per_voxel_ssvdag", ratio(8 * ssvdag_bytes, voxel_count)},
@@ -252,19 +161,19 @@ void measure_scale(const ProbeCall& call, const Model& model, ProbeOutput& out) 
              {"ssvdag_convert (s)", convert_s},
              {"peak_rss_MiB", mib(double(peak_rss_bytes()))},
              {"rss_before_MiB", mib(double(rss_before))},
-             {"rays", rf.rays},
-             {"hit_fraction", rf.hit_fraction},
-             {"svdag_rays_per_s", rf.svdag_rays_per_s},
-             {"ssvdag_rays_per_s", rf.ssvdag_rays_per_s},
-             {"ssvdag_over_svdag_rays_per_s", ratio(rf.ssvdag_rays_per_s, rf.svdag_rays_per_s)},
-             {"rays_disagreeing", rf.disagreeing},
+             {"rays", rays.size()},
+             {"hit_fraction", runs[0].hit_fraction()},
+             {"svdag_rays_per_s", svdag_rays_per_s},
+             {"ssvdag_rays_per_s", ssvdag_rays_per_s},
+             {"ssvdag_over_svdag_rays_per_s", ratio(ssvdag_rays_per_s, svdag_rays_per_s)},
+             {"rays_disagreeing", disagreeing},
              {"same_octree", same},
              {"decode_equal", decode_equal},
              {"threads", threads},
              {"estimated_rss_MiB", mib(double(allowed))},
              {"load_average_before", load_before},
              {"load_average_after", load_average()}});
-        if (!same || decode_equal == false || rf.disagreeing > 0)
+        if (!same || decode_equal == false || disagreeing > 0)
             out.notes.push_back(row_name + ": the SSVDAG disagrees with the SVDAG (see same_octree, decode_equal, "
                                            "rays_disagreeing)");
     } catch (const Error& e) {
@@ -378,7 +287,7 @@ Experiment dag_scale_experiment() {
             "voxelization included; voxelize_share (s/s) is the part the merge spent waiting for voxelized cells (the rest of the voxelizing overlaps the merge). The 1-thread build runs "
             "first under a TBB limit of one thread (ThreadLimit), then the all-thread build the rest of the row "
             "uses.",
-            "SSVDAG: Ssvdag::from_svdag (accel/dag/ssvdag.hpp) on that SVDAG, all threads, wall time. Implemented "
+            "SSVDAG: Ssvdag::from_svdag (accel/dag/symmetric_dag.hpp) on that SVDAG, all threads, wall time. Implemented "
             "from the paper: subtrees equal up to any of the 8 reflections along the grid axes merged, the 3-bit "
             "mirror carried in each pointer, variable-size pointers and ray casting with the mirror applied to the "
             "child order. Storage in 16-bit units: a node is a header unit (child mask, and a bit per child whose "
@@ -402,7 +311,7 @@ Experiment dag_scale_experiment() {
             "which holds exactly when the two hold the same voxels; decode_equal compares the two decoded voxel "
             "lists (Morton codes) literally, on rows up to 2²⁶ voxels (empty above). Rays: one per pixel centre of "
             "a size² image (256² full, 64² quick) from the scene camera, the same rays cast through the SVDAG "
-            "(cast_dag_ray) and the SSVDAG (cast_ssvdag_ray) on all threads, alternating, median rays/s over "
+            "(cast_dag_ray) and the SSVDAG (cast_symmetric_dag_ray) on all threads, alternating, median rays/s over "
             "ray_repetitions passes each; rays_disagreeing counts rays whose hit or hit voxel differs (0 "
             "expected).",
             "Memory: peak_rss_MiB is the row's own peak resident memory (VmHWM reset through /proc/self/clear_refs "

@@ -9,7 +9,7 @@
 #include <tbb/global_control.h>
 #include "accel/dag/child_mask.hpp"
 #include "accel/dag/node_symmetry.hpp"
-#include "accel/dag/ssvdag.hpp"
+#include "accel/dag/symmetric_dag.hpp"
 #include "accel/dag/svdag.hpp"
 #include "accel/dag/symmetric_merge.hpp"
 #include "core/util/morton.hpp"
@@ -203,7 +203,7 @@ TEST(SymmetricMerge, ReflectionsGiveTheSsvdagsSizes) {
         EXPECT_EQ(c.nodes, ssvdag.node_count()) << n;
         EXPECT_EQ(c.level_nodes, ssvdag.level_node_counts()) << n;
         EXPECT_EQ(c.pointers, ssvdag.pointer_count()) << n;
-        EXPECT_EQ(c.transformed_pointers, ssvdag.mirrored_pointer_count()) << n;
+        EXPECT_EQ(c.transformed_pointers, ssvdag.transformed_pointer_count()) << n;
         EXPECT_EQ(c.word_bytes, ssvdag.word_bytes()) << n;
         const SymmetricDagCounts cube = count_symmetric_dag<CubeSymmetryGroup>(svdag);
         EXPECT_LE(cube.nodes, c.nodes) << n;

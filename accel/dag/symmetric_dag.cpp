@@ -1,4 +1,4 @@
-#include "accel/dag/ssvdag.hpp"
+#include "accel/dag/symmetric_dag.hpp"
 #include <algorithm>
 #include <string>
 #include <tbb/blocked_range.h>
@@ -10,29 +10,31 @@
 #include "core/util/morton.hpp"
 
 namespace gilab {
-namespace {
-
-using Merge = SymmetricMerge<ReflectionGroup>;
-inline uint32_t ref_id(uint32_t ref) { return Merge::ref_id(ref); }
-inline uint32_t ref_mirror(uint32_t ref) { return Merge::ref_transform(ref); }
-
-}  // namespace
-
-uint32_t encode_ssvdag_pointer(uint64_t address, uint32_t mirror) {
-    if (address >= kSsvdagAddressLimit)
-        throw Error("SSVDAG", "address " + std::to_string(address) + " does not fit in the 29 bits of a pointer");
-    if (mirror > 7) throw Error("SSVDAG", "mirror " + std::to_string(mirror) + " does not fit in 3 bits");
-    return mirror << kSsvdagMirrorShift | uint32_t(address);
+template <class Group>
+uint32_t SymmetricDag<Group>::encode_long_pointer(uint64_t address, uint32_t transform) {
+    if (address >= kAddressLimit)
+        throw Error("symmetric DAG", "address " + std::to_string(address) + " does not fit in the " +
+                                         std::to_string(kLongTransformShift) + " bits of a pointer");
+    if (transform >= Group::kSize)
+        throw Error("symmetric DAG", "transform " + std::to_string(transform) + " is not one of the " +
+                                         std::to_string(Group::kSize) + " " + Group::kName);
+    return transform << kLongTransformShift | uint32_t(address);
 }
 
 // The layout of the merged levels into units.
-class SsvdagBuilder {
+template <class Group>
+class SymmetricDagBuilder {
 public:
-    explicit SsvdagBuilder(const Svdag& dag) : dag_(dag), depth_(dag.depth()) {}
+    using Dag = SymmetricDag<Group>;
+    using Merge = SymmetricMerge<Group>;
+    static uint32_t ref_id(uint32_t ref) { return Merge::ref_id(ref); }
+    static uint32_t ref_transform(uint32_t ref) { return Merge::ref_transform(ref); }
 
-    Ssvdag build() {
+    explicit SymmetricDagBuilder(const Svdag& dag) : dag_(dag), depth_(dag.depth()) {}
+
+    Dag build() {
         Stopwatch clock;
-        Ssvdag out;
+        Dag out;
         out.grid_ = dag_.grid();
         out.depth_ = depth_;
         out.level_counts_.assign(depth_ + 1, 0);
@@ -77,7 +79,7 @@ private:
         std::vector<uint32_t> offset(refs.size());
         total = 0;
         for (uint32_t id : ids) {
-            offset[id] = uint32_t(std::min<uint64_t>(total, kSsvdagAddressLimit));
+            offset[id] = uint32_t(std::min<uint64_t>(total, Dag::kAddressLimit));
             total += units[id];
         }
         return offset;
@@ -85,7 +87,7 @@ private:
 
     // Levels ordered bottom-up (a node's size depends on which of its children sit within
     // a short pointer's reach), then laid out top-down, then the leaf masks.
-    void lay_out(Ssvdag& out, const Merge& merge) {
+    void lay_out(Dag& out, const Merge& merge) {
         const std::vector<DagLevelTable>& tables = merge.tables();  // levels 0..depth-2
         const std::vector<uint8_t>& leaf_masks = merge.leaf_masks();  // level depth-1, by id
         const uint32_t root_ref = merge.root_ref();
@@ -101,7 +103,7 @@ private:
             offset[size_t(interior)] =
                 order_by_references(refs, std::vector<uint8_t>(leaf_masks.size(), 1), masks_total);
         }
-        const auto is_short = [](uint32_t child_offset) { return child_offset < kSsvdagShortOffsetLimit; };
+        const auto is_short = [](uint32_t child_offset) { return child_offset < Dag::kShortOffsetLimit; };
         for (int l = interior - 1; l >= 0; --l) {
             const DagLevelTable& t = tables[size_t(l)];
             std::vector<uint8_t> units(t.size());
@@ -128,9 +130,11 @@ private:
         out.level_counts_[size_t(depth_ - 1)] = leaf_masks.size();
         out.word_bytes_ += 4 * ((leaf_masks.size() + 3) / 4);
         // Every interior address must fit a long pointer; checked before allocating the units.
-        if (next > kSsvdagAddressLimit)
-            throw Error("SSVDAG", "the DAG needs " + std::to_string(next) +
-                                      " units of nodes, more than the 2^29 that 29-bit pointers address");
+        if (next > Dag::kAddressLimit)
+            throw Error("symmetric DAG", "the DAG under the " + std::string(Group::kName) + " needs " +
+                                             std::to_string(next) + " units of nodes, more than the 2^" +
+                                             std::to_string(Dag::kLongTransformShift) + " that " +
+                                             std::to_string(Dag::kLongTransformShift) + "-bit pointers address");
         out.child_level_begin_.assign(size_t(std::max(interior, 0)), 0);
         for (int l = 0; l + 1 < interior; ++l) out.child_level_begin_[size_t(l)] = uint32_t(out.level_begin_[size_t(l + 1)]);
         out.leaf_begin_ = uint32_t(next);
@@ -155,11 +159,11 @@ private:
                                       for (uint32_t slot = 0, k = 0; slot < 8; ++slot) {
                                           if (!(header & (1u << slot))) continue;
                                           const uint32_t child_offset = below[ref_id(kids[k])];
-                                          const uint32_t mirror = ref_mirror(kids[k++]);
+                                          const uint32_t transform = ref_transform(kids[k++]);
                                           if (is_short(child_offset)) {
-                                              node[at++] = uint16_t(mirror << kSsvdagShortMirrorShift | child_offset);
+                                              node[at++] = uint16_t(transform << Dag::kShortTransformShift | child_offset);
                                           } else {
-                                              const uint32_t word = mirror << kSsvdagMirrorShift | (below_begin + child_offset);
+                                              const uint32_t word = transform << Dag::kLongTransformShift | (below_begin + child_offset);
                                               node[at++] = uint16_t(word & 0xffffu);
                                               node[at++] = uint16_t(word >> 16);
                                               long_mask |= 1u << slot;
@@ -170,31 +174,38 @@ private:
                               });
             for (uint32_t u = 0; u < t.size(); ++u)
                 for (uint32_t ref : t.children(u)) {
-                    out.mirrored_pointer_count_ += ref_mirror(ref) != 0;
+                    out.transformed_pointer_count_ += ref_transform(ref) != 0;
+                    out.permuting_pointer_count_ += ref_transform(ref) >= ReflectionGroup::kSize;
                     out.long_pointer_count_ += !is_short(below[ref_id(ref)]);
                 }
             std::vector<uint32_t>().swap(offset[size_t(l)]);
         }
-        out.root_ = {depth_ == 1 ? offset[0][ref_id(root_ref)] : 0u, ref_mirror(root_ref)};
+        out.root_ = {depth_ == 1 ? offset[0][ref_id(root_ref)] : 0u, ref_transform(root_ref)};
     }
 
     const Svdag& dag_;
     int depth_;
 };
 
-Ssvdag Ssvdag::from_svdag(const Svdag& dag) { return SsvdagBuilder(dag).build(); }
+template <class Group>
+SymmetricDag<Group> SymmetricDag<Group>::from_svdag(const Svdag& dag) {
+    return SymmetricDagBuilder<Group>(dag).build();
+}
 
-std::optional<SsvdagPointer> Ssvdag::child(const SsvdagPointer& node, int level, int slot) const {
-    const uint32_t stored_slot = uint32_t(slot) ^ node.mirror;
+template <class Group>
+std::optional<SymmetricDagPointer> SymmetricDag<Group>::child(const SymmetricDagPointer& node, int level,
+                                                               int slot) const {
+    const uint32_t stored_slot = Group::source_slot(node.transform, uint32_t(slot));
     const uint32_t m = stored_mask(node.address, level);
     if (!(m & (1u << stored_slot))) return std::nullopt;
-    if (level == depth_ - 1) return SsvdagPointer{0, node.mirror};  // a voxel: not stored
-    SsvdagPointer c = stored_child(node.address, level, stored_slot);
-    c.mirror ^= node.mirror;
+    if (level == depth_ - 1) return SymmetricDagPointer{0, node.transform};  // a voxel: not stored
+    SymmetricDagPointer c = stored_child(node.address, level, stored_slot);
+    c.transform = Group::compose(node.transform, c.transform);
     return c;
 }
 
-std::vector<uint32_t> Ssvdag::level_nodes(int level) const {
+template <class Group>
+std::vector<uint32_t> SymmetricDag<Group>::level_nodes(int level) const {
     std::vector<uint32_t> nodes;
     if (empty_ || level < 0 || level >= depth_) return nodes;
     if (level == depth_ - 1) {
@@ -207,16 +218,18 @@ std::vector<uint32_t> Ssvdag::level_nodes(int level) const {
     return nodes;
 }
 
-size_t Ssvdag::node_count() const {
+template <class Group>
+size_t SymmetricDag<Group>::node_count() const {
     size_t n = 0;
     for (uint64_t c : level_counts_) n += c;
     return n;
 }
 
-uint64_t Ssvdag::voxel_count() const {
+template <class Group>
+uint64_t SymmetricDag<Group>::voxel_count() const {
     if (empty_) return 0;
     if (depth_ == 0) return 1;
-    // Voxels below each stored node, from the leaf masks up; reflections keep the count.
+    // Voxels below each stored node, from the leaf masks up; symmetries keep the count.
     std::vector<uint64_t> leaf_voxels(level_counts_[depth_ - 1]);
     for (uint32_t i = 0; i < leaf_voxels.size(); ++i) leaf_voxels[i] = child_count(leaf_mask(i));
     if (depth_ == 1) return leaf_voxels[root_.address];
@@ -233,9 +246,10 @@ uint64_t Ssvdag::voxel_count() const {
     return below[root_.address];
 }
 
-bool Ssvdag::contains_voxel(const UVec3& v) const {
+template <class Group>
+bool SymmetricDag<Group>::contains_voxel(const UVec3& v) const {
     if (empty_ || v.x >= grid_.resolution || v.y >= grid_.resolution || v.z >= grid_.resolution) return false;
-    SsvdagPointer node = root_;
+    SymmetricDagPointer node = root_;
     for (int l = 0; l < depth_; ++l) {
         const int shift = depth_ - 1 - l;
         const auto c = child(node, l, octree_child_slot(v.x >> shift, v.y >> shift, v.z >> shift));
@@ -245,17 +259,19 @@ bool Ssvdag::contains_voxel(const UVec3& v) const {
     return true;
 }
 
-bool Ssvdag::occupied(const Vec3& p) const {
+template <class Group>
+bool SymmetricDag<Group>::occupied(const Vec3& p) const {
     const auto v = grid_.voxel_of(p);
     return v && contains_voxel(*v);
 }
 
-std::vector<uint64_t> Ssvdag::decode() const {
+template <class Group>
+std::vector<uint64_t> SymmetricDag<Group>::decode() const {
     std::vector<uint64_t> codes;
     if (empty_) return codes;
     if (depth_ == 0) return {0};
     struct Item {
-        SsvdagPointer node;
+        SymmetricDagPointer node;
         int level;
         uint64_t code;
     };
@@ -276,11 +292,13 @@ std::vector<uint64_t> Ssvdag::decode() const {
     return codes;
 }
 
-Stats Ssvdag::stats() const {
+template <class Group>
+Stats SymmetricDag<Group>::stats() const {
     Stats s;
     s.set("nodes", double(node_count()));
     s.set("pointers", double(pointer_count()));
-    s.set("mirrored_pointers", double(mirrored_pointer_count()));
+    s.set("transformed_pointers", double(transformed_pointer_count()));
+    s.set("permuting_pointers", double(permuting_pointer_count()));
     s.set("long_pointers", double(long_pointer_count()));
     s.set("bytes", double(bytes()));
     s.set("word_bytes", double(word_bytes()));
@@ -292,5 +310,8 @@ Stats Ssvdag::stats() const {
         s.set("nodes_level_" + std::to_string(l), double(level_counts_[l]));
     return s;
 }
+
+template class SymmetricDag<ReflectionGroup>;
+template class SymmetricDag<CubeSymmetryGroup>;
 
 }  // namespace gilab

@@ -1,6 +1,7 @@
-// SSVDAG: subtrees equal up to a reflection share one node with the right mirrors, every
-// level holds exactly one node per reflection class, and the SSVDAG answers decode, point
-// queries and ray casts exactly as the SVDAG it was built from.
+// Symmetry-aware DAGs: in the SSVDAG subtrees equal up to a reflection share one node with
+// the right mirrors, in the cube-symmetric DAG subtrees equal up to an axis permutation as
+// well; both hold exactly one node per class of their group on every level, and answer
+// decode, point queries and ray casts exactly as the SVDAG they were built from.
 #include <gtest/gtest.h>
 #include <algorithm>
 #include <bit>
@@ -12,8 +13,8 @@
 #include <vector>
 #include <tbb/global_control.h>
 #include "accel/dag/dag_ray_caster.hpp"
-#include "accel/dag/ssvdag.hpp"
-#include "accel/dag/ssvdag_ray_caster.hpp"
+#include "accel/dag/symmetric_dag.hpp"
+#include "accel/dag/symmetric_dag_ray_caster.hpp"
 #include "accel/dag/svdag.hpp"
 #include "core/io/mesh_loaders.hpp"
 #include "core/scene/scene.hpp"
@@ -114,17 +115,42 @@ std::vector<uint64_t> subtree_codes(const Node& node, int level, int depth, Chil
     return codes;
 }
 
-// The smallest of a subtree's 8 reflections (coordinates within a cell of `side` voxels):
-// equal for two subtrees exactly when one is a reflection of the other.
-std::vector<uint64_t> reflection_class(const std::vector<uint64_t>& codes, uint32_t side) {
+// Voxels of a cell of `side` voxels moved by cube symmetry t (node_symmetry.hpp): the
+// axes permuted by t / 8, then reflected by t % 8 (for t < 8, `reflected`).
+std::vector<UVec3> transformed(const std::vector<UVec3>& voxels, uint32_t t, uint32_t side) {
+    std::vector<UVec3> out;
+    for (const UVec3& v : voxels) {
+        UVec3 m;
+        for (int a = 0; a < 3; ++a) m[a] = v[detail::kAxisOf[t >> 3][a]];
+        out.push_back(m);
+    }
+    return reflected(out, t & 7u, side);
+}
+
+// The smallest of a subtree's images under the group (coordinates within a cell of `side`
+// voxels): equal for two subtrees exactly when the group maps one onto the other.
+template <class Group>
+std::vector<uint64_t> symmetry_class(const std::vector<uint64_t>& codes, uint32_t side) {
     std::vector<UVec3> voxels;
     for (uint64_t c : codes) voxels.push_back(morton_decode(c));
     std::vector<uint64_t> best;
-    for (uint32_t m = 0; m < 8; ++m) {
-        std::vector<uint64_t> r = sorted_codes(reflected(voxels, m, side));
-        if (m == 0 || r < best) best = r;
+    for (uint32_t t = 0; t < Group::kSize; ++t) {
+        std::vector<uint64_t> r = sorted_codes(transformed(voxels, t, side));
+        if (t == 0 || r < best) best = r;
     }
     return best;
+}
+
+// Classes of non-empty child masks under the group: the most nodes the voxels' parents' level can hold.
+template <class Group>
+size_t mask_classes() {
+    std::set<uint32_t> smallest;
+    for (uint32_t mask = 1; mask < 256; ++mask) {
+        uint32_t best = mask;
+        for (uint32_t t = 0; t < Group::kSize; ++t) best = std::min<uint32_t>(best, Group::transform_mask(t, mask));
+        smallest.insert(best);
+    }
+    return smallest.size();
 }
 
 std::vector<uint64_t> svdag_subtree(const Svdag& dag, uint32_t node, int level) {
@@ -134,33 +160,37 @@ std::vector<uint64_t> svdag_subtree(const Svdag& dag, uint32_t node, int level) 
     });
 }
 
-std::vector<uint64_t> ssvdag_subtree(const Ssvdag& dag, const SsvdagPointer& node, int level) {
+template <class Dag>
+std::vector<uint64_t> symmetric_dag_subtree(const Dag& dag, const SymmetricDagPointer& node, int level) {
     return subtree_codes(node, level, dag.depth(),
-                         [&](const SsvdagPointer& n, int l, int s) { return dag.child(n, l, s); });
+                         [&](const SymmetricDagPointer& n, int l, int s) { return dag.child(n, l, s); });
 }
 
-// The SSVDAG is minimal over reflections: on every level its nodes are pairwise
-// inequivalent and there are exactly as many as there are reflection classes among the
-// SVDAG's nodes; each stored node decodes to a subtree of one of those classes.
-void expect_one_node_per_reflection_class(const Svdag& svdag, const Ssvdag& dag) {
+// The DAG is minimal over its group: on every level its nodes are pairwise inequivalent
+// and there are exactly as many as there are classes among the SVDAG's nodes; each stored
+// node decodes to a subtree of one of those classes.
+template <class Dag>
+void expect_one_node_per_class(const Svdag& svdag, const Dag& dag) {
+    using Group = typename Dag::SymmetryGroup;
     for (int l = 0; l < dag.depth(); ++l) {
         const uint32_t side = 1u << (dag.depth() - l);
         std::set<std::vector<uint64_t>> svdag_classes, ssvdag_classes;
         for (uint32_t a : svdag.level_nodes(l))
-            svdag_classes.insert(reflection_class(svdag_subtree(svdag, a, l), side));
+            svdag_classes.insert(symmetry_class<Group>(svdag_subtree(svdag, a, l), side));
         const std::vector<uint32_t> nodes = dag.level_nodes(l);
         ASSERT_EQ(nodes.size(), dag.level_node_counts()[l]);
         for (uint32_t a : nodes) {
-            const auto cls = reflection_class(ssvdag_subtree(dag, SsvdagPointer{a, 0}, l), side);
-            EXPECT_TRUE(ssvdag_classes.insert(cls).second) << "level " << l << ": two nodes are mirror images";
+            const auto cls = symmetry_class<Group>(symmetric_dag_subtree(dag, SymmetricDagPointer{a, 0}, l), side);
+            EXPECT_TRUE(ssvdag_classes.insert(cls).second) << "level " << l << ": two nodes are images of each other";
             EXPECT_TRUE(svdag_classes.count(cls)) << "level " << l << ": a node of no SVDAG subtree";
         }
         EXPECT_EQ(ssvdag_classes.size(), svdag_classes.size()) << "level " << l;
     }
 }
 
-// Everything the SSVDAG answers from its words, against the SVDAG.
-void expect_same_voxels(const Svdag& svdag, const Ssvdag& dag, const std::string& what) {
+// Everything the DAG answers from its units, against the SVDAG.
+template <class Dag>
+void expect_same_voxels(const Svdag& svdag, const Dag& dag, const std::string& what) {
     EXPECT_EQ(dag.decode(), svdag.decode()) << what;
     EXPECT_EQ(dag.voxel_count(), svdag.voxel_count()) << what;
     EXPECT_EQ(dag.depth(), svdag.depth()) << what;
@@ -173,15 +203,17 @@ void expect_same_voxels(const Svdag& svdag, const Ssvdag& dag, const std::string
 }
 
 // Units of the node at `address` on an interior level: header, short and long pointers.
-uint32_t node_units(const Ssvdag& dag, uint32_t address) {
+template <class Dag>
+uint32_t node_units(const Dag& dag, uint32_t address) {
     const uint32_t header = dag.units()[address];
     return 1 + uint32_t(std::popcount(header & 0xffu)) + uint32_t(std::popcount(header >> 8));
 }
 
-// The layout of ssvdag.hpp: every pointer names a node of the level below, it is long
+// The layout of symmetric_dag.hpp: every pointer names a node of the level below, it is long
 // exactly when the child lies beyond a short pointer's reach, each level is ordered by
 // references per unit (most first), and the counts and bytes follow from the units.
-void check_storage(const Ssvdag& dag) {
+template <class Dag>
+void check_storage(const Dag& dag) {
     ASSERT_FALSE(dag.empty());
     const auto units = dag.units();
     size_t pointers = 0, mirrored = 0, long_pointers = 0, interior_units = 0, words = 0;
@@ -196,13 +228,13 @@ void check_storage(const Ssvdag& dag) {
             ASSERT_EQ(long_mask & ~mask, 0u) << "long-pointer bits only on children";
             for (uint32_t slot = 0; slot < 8; ++slot) {
                 if (!(mask & (1u << slot))) continue;
-                const SsvdagPointer p = dag.stored_child(a, l, slot);
+                const SymmetricDagPointer p = dag.stored_child(a, l, slot);
                 ASSERT_TRUE(std::ranges::binary_search(below_nodes, p.address)) << "level " << l;
                 const bool is_long = (long_mask >> slot) & 1u;
-                EXPECT_EQ(is_long, p.address - below_begin >= kSsvdagShortOffsetLimit)
+                EXPECT_EQ(is_long, p.address - below_begin >= Dag::kShortOffsetLimit)
                     << "level " << l << ": a pointer is short exactly when its child is within reach";
                 ++references[p.address];
-                mirrored += p.mirror != 0;
+                mirrored += p.transform != 0;
                 long_pointers += is_long;
                 ++pointers;
             }
@@ -219,10 +251,10 @@ void check_storage(const Ssvdag& dag) {
     }
     EXPECT_EQ(dag.leaf_begin(), interior_units);
     EXPECT_EQ(pointers, dag.pointer_count());
-    EXPECT_EQ(mirrored, dag.mirrored_pointer_count());
+    EXPECT_EQ(mirrored, dag.transformed_pointer_count());
     EXPECT_EQ(long_pointers, dag.long_pointer_count());
     const size_t leaves = dag.level_node_counts()[dag.depth() - 1];
-    EXPECT_LE(leaves, 45u) << "45 classes of non-empty masks under the 8 reflections";
+    EXPECT_LE(leaves, mask_classes<typename Dag::SymmetryGroup>()) << "one node per class of non-empty masks";
     EXPECT_EQ(dag.bytes(), 2 * (interior_units + (leaves + 1) / 2));
     EXPECT_EQ(dag.word_bytes(), 4 * (words + (leaves + 3) / 4));
     for (uint32_t i = 0; i < leaves; ++i) EXPECT_NE(dag.leaf_mask(i), 0);
@@ -230,12 +262,13 @@ void check_storage(const Ssvdag& dag) {
 
 // Ray casts agree exactly with cast_dag_ray on the SVDAG: both walk the same cells in the
 // same order, so hit, voxel, distance and visits are identical.
-void expect_same_rays(const Svdag& svdag, const Ssvdag& dag, const std::vector<Ray>& rays, const std::string& what) {
+template <class Dag>
+void expect_same_rays(const Svdag& svdag, const Dag& dag, const std::vector<Ray>& rays, const std::string& what) {
     const DagWordsView view = dag_view(svdag);
     int hits = 0, mismatches = 0;
     for (size_t i = 0; i < rays.size(); ++i) {
         const VoxelRayHit want = cast_dag_ray(view, rays[i]);
-        const VoxelRayHit got = cast_ssvdag_ray(dag, rays[i]);
+        const VoxelRayHit got = cast_symmetric_dag_ray(dag, rays[i]);
         hits += want.hit;
         const bool same = got.hit == want.hit && got.voxel == want.voxel && got.t == want.t &&
                           got.nodes_visited == want.nodes_visited;
@@ -265,7 +298,8 @@ std::vector<Ray> many_rays(uint32_t seed) {
     return rays;
 }
 
-void expect_same_points(const Svdag& svdag, const Ssvdag& dag, const std::vector<uint64_t>& codes, uint32_t seed) {
+template <class Dag>
+void expect_same_points(const Svdag& svdag, const Dag& dag, const std::vector<uint64_t>& codes, uint32_t seed) {
     std::mt19937 rng(seed);
     const VoxelGrid& g = svdag.grid();
     int occupied = 0;
@@ -303,14 +337,14 @@ TEST(Ssvdag, MirrorImagesInSiblingOctantsShareOneNode) {
     const auto a = dag.child(dag.root(), 0, 0), b = dag.child(dag.root(), 0, 1);
     ASSERT_TRUE(a && b);
     EXPECT_EQ(a->address, b->address);
-    EXPECT_EQ(a->mirror ^ b->mirror, 1u) << "the two views differ by the x reflection";
+    EXPECT_EQ(a->transform ^ b->transform, 1u) << "the two views differ by the x reflection";
     // The root's header holds the mask and no long pointers; its two short pointers carry
     // those mirrors in their top 3 bits.
-    const uint32_t root = dag.root().address, rm = dag.root().mirror;
+    const uint32_t root = dag.root().address, rm = dag.root().transform;
     ASSERT_EQ(dag.units()[root], uint32_t(reflect_mask(0b11, rm)));
     const uint32_t first = dag.units()[root + 1], second = dag.units()[root + 2];
-    EXPECT_EQ(first & kSsvdagShortOffsetMask, second & kSsvdagShortOffsetMask);
-    EXPECT_EQ((first ^ second) >> kSsvdagShortMirrorShift, 1u);
+    EXPECT_EQ(first & Ssvdag::kShortOffsetMask, second & Ssvdag::kShortOffsetMask);
+    EXPECT_EQ((first ^ second) >> Ssvdag::kShortTransformShift, 1u);
     EXPECT_EQ(dag.decode(), codes);
     check_storage(dag);
 }
@@ -338,10 +372,10 @@ TEST(Ssvdag, AllEightReflectionsOfAShapeShareOneNode) {
         const auto c = dag.child(dag.root(), 0, k);
         ASSERT_TRUE(c);
         EXPECT_EQ(c->address, base->address) << "slot " << k;
-        EXPECT_EQ(c->mirror ^ base->mirror, uint32_t(k)) << "slot " << k;
+        EXPECT_EQ(c->transform ^ base->transform, uint32_t(k)) << "slot " << k;
     }
     // The whole scene is symmetric under every reflection: the root is seen unmirrored.
-    EXPECT_EQ(dag.root().mirror, 0u);
+    EXPECT_EQ(dag.root().transform, 0u);
     EXPECT_EQ(dag.decode(), codes);
     expect_same_rays(svdag, dag, many_rays(1), "8 reflections");
 }
@@ -368,15 +402,15 @@ TEST(Ssvdag, SymmetricSubtreesGetTheSmallestMirror) {
     const Ssvdag dag = Ssvdag::from_svdag(svdag);
 
     const auto pointer_at = [&](int slot) {
-        return dag.stored_child(dag.root().address, 0, uint32_t(slot) ^ dag.root().mirror);
+        return dag.stored_child(dag.root().address, 0, uint32_t(slot) ^ dag.root().transform);
     };
     // Stored pointers name each subtree by the smallest of its equivalent mirrors.
-    EXPECT_EQ(pointer_at(0).mirror, 0u);
-    const SsvdagPointer a = pointer_at(1), b = pointer_at(2);
+    EXPECT_EQ(pointer_at(0).transform, 0u);
+    const SymmetricDagPointer a = pointer_at(1), b = pointer_at(2);
     EXPECT_EQ(a.address, b.address);
-    EXPECT_EQ(a.mirror & 1u, 0u);
-    EXPECT_EQ(b.mirror & 1u, 0u);
-    EXPECT_EQ(a.mirror ^ b.mirror, 2u);
+    EXPECT_EQ(a.transform & 1u, 0u);
+    EXPECT_EQ(b.transform & 1u, 0u);
+    EXPECT_EQ(a.transform ^ b.transform, 2u);
     EXPECT_EQ(dag.child(dag.root(), 0, 1)->address, a.address);
     EXPECT_EQ(dag.level_node_counts()[1], 2u);
     EXPECT_EQ(dag.decode(), codes);
@@ -386,31 +420,36 @@ TEST(Ssvdag, SymmetricSubtreesGetTheSmallestMirror) {
     EXPECT_EQ(again.root(), dag.root());
 }
 
-TEST(Ssvdag, EveryLevelHoldsOneNodePerReflectionClass) {
+template <class Dag>
+class SymmetricDagTest : public ::testing::Test {};
+using SymmetricDags = ::testing::Types<Ssvdag, CubeSymmetricDag>;
+TYPED_TEST_SUITE(SymmetricDagTest, SymmetricDags);
+
+TYPED_TEST(SymmetricDagTest, EveryLevelHoldsOneNodePerSymmetryClass) {
     for (uint32_t n : {2u, 8u, 13u, 32u}) {
         const VoxelGrid grid = gilab::test::unit_grid(n);
         const std::vector<uint64_t> codes = mixed_voxels(n);
         const Svdag svdag = Svdag::from_voxels(grid, codes);
-        const Ssvdag dag = Ssvdag::from_svdag(svdag);
-        expect_one_node_per_reflection_class(svdag, dag);
+        const TypeParam dag = TypeParam::from_svdag(svdag);
+        expect_one_node_per_class(svdag, dag);
     }
     for (double fill : {0.05, 0.5, 0.95}) {
         std::mt19937 rng(unsigned(fill * 1000));
         const std::vector<uint64_t> codes = gilab::test::random_voxels(rng, 16, fill);
         const Svdag svdag = Svdag::from_voxels(gilab::test::unit_grid(16), codes);
-        expect_one_node_per_reflection_class(svdag, Ssvdag::from_svdag(svdag));
+        expect_one_node_per_class(svdag, TypeParam::from_svdag(svdag));
     }
     const std::vector<uint64_t> sphere = centred_sphere_voxels(32);
     const Svdag svdag = Svdag::from_voxels(gilab::test::unit_grid(32), sphere);
-    expect_one_node_per_reflection_class(svdag, Ssvdag::from_svdag(svdag));
+    expect_one_node_per_class(svdag, TypeParam::from_svdag(svdag));
 }
 
-TEST(Ssvdag, DecodesToTheSvdagsVoxels) {
+TYPED_TEST(SymmetricDagTest, DecodesToTheSvdagsVoxels) {
     for (uint32_t n : {1u, 2u, 3u, 13u, 32u, 64u, 100u, 256u}) {
         const VoxelGrid grid = gilab::test::unit_grid(n);
         const std::vector<uint64_t> codes = mixed_voxels(n);
         const Svdag svdag = Svdag::from_voxels(grid, codes);
-        const Ssvdag dag = Ssvdag::from_svdag(svdag);
+        const TypeParam dag = TypeParam::from_svdag(svdag);
         expect_same_voxels(svdag, dag, "mixed " + std::to_string(n));
         EXPECT_EQ(dag.decode(), codes);
         if (dag.depth() > 0) check_storage(dag);
@@ -420,13 +459,13 @@ TEST(Ssvdag, DecodesToTheSvdagsVoxels) {
             std::mt19937 rng(n * 1000 + unsigned(fill * 100));
             const std::vector<uint64_t> codes = gilab::test::random_voxels(rng, n, fill);
             const Svdag svdag = Svdag::from_voxels(gilab::test::unit_grid(n), codes);
-            const Ssvdag dag = Ssvdag::from_svdag(svdag);
+            const TypeParam dag = TypeParam::from_svdag(svdag);
             expect_same_voxels(svdag, dag, "random " + std::to_string(n) + " fill " + std::to_string(fill));
             if (!codes.empty()) check_storage(dag);
         }
 }
 
-TEST(Ssvdag, EveryMaskOfADepthOneGrid) {
+TYPED_TEST(SymmetricDagTest, EveryMaskOfADepthOneGrid) {
     const VoxelGrid grid = gilab::test::unit_grid(2);
     const std::vector<Ray> rays = many_rays(3);
     for (uint32_t mask = 1; mask < 256; ++mask) {
@@ -434,13 +473,13 @@ TEST(Ssvdag, EveryMaskOfADepthOneGrid) {
         for (uint64_t s = 0; s < 8; ++s)
             if (mask & (1u << s)) codes.push_back(s);
         const Svdag svdag = Svdag::from_voxels(grid, codes);
-        const Ssvdag dag = Ssvdag::from_svdag(svdag);
+        const TypeParam dag = TypeParam::from_svdag(svdag);
         ASSERT_EQ(dag.decode(), codes) << "mask " << mask;
         ASSERT_EQ(dag.mask(dag.root(), 0), mask);
         ASSERT_EQ(dag.voxel_count(), codes.size());
         ASSERT_EQ(dag.bytes(), 2u) << "one mask byte in one unit";
         for (size_t i = 0; i < rays.size(); i += 7) {
-            const VoxelRayHit want = cast_dag_ray(dag_view(svdag), rays[i]), got = cast_ssvdag_ray(dag, rays[i]);
+            const VoxelRayHit want = cast_dag_ray(dag_view(svdag), rays[i]), got = cast_symmetric_dag_ray(dag, rays[i]);
             ASSERT_EQ(got.hit, want.hit) << "mask " << mask << " ray " << i;
             ASSERT_EQ(got.voxel, want.voxel) << "mask " << mask << " ray " << i;
             ASSERT_EQ(got.t, want.t);
@@ -451,6 +490,7 @@ TEST(Ssvdag, EveryMaskOfADepthOneGrid) {
 namespace {
 
 // A mesh from the shared scenes at several resolutions: storage, decode, points and rays.
+template <class Dag>
 void check_shared_mesh(const std::string& asset, std::initializer_list<uint32_t> resolutions) {
     const auto path = gilab::test::shared_asset(asset);
     if (!path) GTEST_SKIP() << asset << " not found in the shared scenes";
@@ -460,7 +500,7 @@ void check_shared_mesh(const std::string& asset, std::initializer_list<uint32_t>
         const VoxelGrid grid = VoxelGrid::enclosing(frame.bounds, n);
         const std::vector<uint64_t> codes = voxelize(frame, grid).codes;
         const Svdag svdag = Svdag::from_voxels(grid, codes);
-        const Ssvdag dag = Ssvdag::from_svdag(svdag);
+        const Dag dag = Dag::from_svdag(svdag);
         const std::string what = asset + " at " + std::to_string(n);
         expect_same_voxels(svdag, dag, what);
         check_storage(dag);
@@ -479,36 +519,36 @@ void check_shared_mesh(const std::string& asset, std::initializer_list<uint32_t>
 
 }  // namespace
 
-TEST(Ssvdag, StanfordBunnyMatchesTheSvdag) { check_shared_mesh("bunny/stanford-bunny.obj", {64, 256}); }
+TYPED_TEST(SymmetricDagTest, StanfordBunnyMatchesTheSvdag) { check_shared_mesh<TypeParam>("bunny/stanford-bunny.obj", {64, 256}); }
 
-TEST(Ssvdag, SponzaMatchesTheSvdag) { check_shared_mesh("sponza/sponza.obj", {512}); }
+TYPED_TEST(SymmetricDagTest, SponzaMatchesTheSvdag) { check_shared_mesh<TypeParam>("sponza/sponza.obj", {512}); }
 
-TEST(Ssvdag, PointQueriesMatchTheSvdag) {
+TYPED_TEST(SymmetricDagTest, PointQueriesMatchTheSvdag) {
     for (uint32_t n : {16u, 48u, 100u}) {
         const std::vector<uint64_t> codes = mixed_voxels(n);
         const Svdag svdag = Svdag::from_voxels(gilab::test::unit_grid(n), codes);
-        expect_same_points(svdag, Ssvdag::from_svdag(svdag), codes, n);
+        expect_same_points(svdag, TypeParam::from_svdag(svdag), codes, n);
     }
     std::mt19937 rng(4);
     const std::vector<uint64_t> codes = gilab::test::random_voxels(rng, 32, 0.2);
     const Svdag svdag = Svdag::from_voxels(gilab::test::unit_grid(32), codes);
-    expect_same_points(svdag, Ssvdag::from_svdag(svdag), codes, 4);
+    expect_same_points(svdag, TypeParam::from_svdag(svdag), codes, 4);
 }
 
-TEST(Ssvdag, RayCastsMatchCastDagRay) {
+TYPED_TEST(SymmetricDagTest, RayCastsMatchCastDagRay) {
     for (uint32_t resolution : {4u, 8u, 64u, 512u}) {
         const VoxelGrid grid = gilab::test::unit_grid(resolution);
         const TriangleSoup soup = clutter_and_sphere(3);
         const Svdag svdag = Svdag::from_voxels(grid, voxelize(soup.positions, soup.triangles, grid).codes);
-        expect_same_rays(svdag, Ssvdag::from_svdag(svdag), many_rays(resolution), std::to_string(resolution) + "³");
+        expect_same_rays(svdag, TypeParam::from_svdag(svdag), many_rays(resolution), std::to_string(resolution) + "³");
     }
     std::mt19937 rng(17);
     const std::vector<uint64_t> random = gilab::test::random_voxels(rng, 32, 0.01);
     const Svdag random_dag = Svdag::from_voxels(gilab::test::unit_grid(32), random);
-    expect_same_rays(random_dag, Ssvdag::from_svdag(random_dag), many_rays(32), "random voxels");
+    expect_same_rays(random_dag, TypeParam::from_svdag(random_dag), many_rays(32), "random voxels");
 
     const Svdag sphere = Svdag::from_voxels(gilab::test::unit_grid(128), centred_sphere_voxels(128));
-    expect_same_rays(sphere, Ssvdag::from_svdag(sphere), many_rays(128), "centred sphere");
+    expect_same_rays(sphere, TypeParam::from_svdag(sphere), many_rays(128), "centred sphere");
 
     // Resolution 48 (an octree of 64) on a grid at (-2, 5, 1) with side 3: rays move with it.
     VoxelGrid grid;
@@ -523,17 +563,17 @@ TEST(Ssvdag, RayCastsMatchCastDagRay) {
         r.origin = grid.origin + r.origin * grid.extent;
         r.direction *= grid.extent;
     }
-    expect_same_rays(offset, Ssvdag::from_svdag(offset), rays, "offset 48³ grid");
+    expect_same_rays(offset, TypeParam::from_svdag(offset), rays, "offset 48³ grid");
 }
 
-TEST(Ssvdag, NodesBeyondAShortPointersReachGetLongPointers) {
+TYPED_TEST(SymmetricDagTest, NodesBeyondAShortPointersReachGetLongPointers) {
     // Random voxels: about 4000 distinct nodes of 9–17 units on the level above the
     // voxels' parents, far more than a short pointer's 2^13 units reach.
     std::mt19937 rng(23);
     const std::vector<uint64_t> codes = gilab::test::random_voxels(rng, 64, 0.3);
     const Svdag svdag = Svdag::from_voxels(gilab::test::unit_grid(64), codes);
-    const Ssvdag dag = Ssvdag::from_svdag(svdag);
-    ASSERT_GT(dag.level_begin(dag.depth() - 1) - dag.level_begin(dag.depth() - 2), 2 * kSsvdagShortOffsetLimit);
+    const TypeParam dag = TypeParam::from_svdag(svdag);
+    ASSERT_GT(dag.level_begin(dag.depth() - 1) - dag.level_begin(dag.depth() - 2), 2 * TypeParam::kShortOffsetLimit);
     EXPECT_GT(dag.long_pointer_count(), 0u);
     EXPECT_LT(dag.long_pointer_count(), dag.pointer_count()) << "the most referenced nodes stay within reach";
     check_storage(dag);
@@ -542,29 +582,29 @@ TEST(Ssvdag, NodesBeyondAShortPointersReachGetLongPointers) {
     expect_same_rays(svdag, dag, many_rays(64), "random 64³");
 }
 
-TEST(Ssvdag, NeverMoreNodesAndFewerOnASymmetricScene) {
+TYPED_TEST(SymmetricDagTest, NeverMoreNodesAndFewerOnASymmetricScene) {
     for (uint32_t n : {32u, 128u, 256u}) {
         const std::vector<uint64_t> codes = centred_sphere_voxels(n);
         const Svdag svdag = Svdag::from_voxels(gilab::test::unit_grid(n), codes);
-        const Ssvdag dag = Ssvdag::from_svdag(svdag);
+        const TypeParam dag = TypeParam::from_svdag(svdag);
         expect_same_voxels(svdag, dag, "sphere " + std::to_string(n));
         EXPECT_LT(dag.node_count(), svdag.node_count()) << n;
         EXPECT_LT(dag.bytes(), svdag.bytes()) << n;
         // Mirror images of one another: the root's children are one node.
         EXPECT_EQ(dag.level_node_counts()[1], 1u) << n;
-        EXPECT_GT(dag.mirrored_pointer_count(), 0u);
+        EXPECT_GT(dag.transformed_pointer_count(), 0u);
     }
 }
 
-TEST(Ssvdag, SameUnitsWithOneAndTwoThreads) {
+TYPED_TEST(SymmetricDagTest, SameUnitsWithOneAndTwoThreads) {
     std::mt19937 rng(6);
     const std::vector<uint64_t> codes = gilab::test::random_voxels(rng, 100, 0.05);
     const Svdag svdag = Svdag::from_voxels(gilab::test::unit_grid(100), codes);
     ASSERT_GT(svdag.level_node_counts()[5], 10000u) << "enough nodes on a level to split among threads";
-    std::vector<Ssvdag> builds;
+    std::vector<TypeParam> builds;
     for (size_t threads : {1, 2}) {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-        builds.push_back(Ssvdag::from_svdag(svdag));
+        builds.push_back(TypeParam::from_svdag(svdag));
     }
     EXPECT_TRUE(std::ranges::equal(builds[0].units(), builds[1].units()));
     EXPECT_EQ(builds[0].root(), builds[1].root());
@@ -572,9 +612,9 @@ TEST(Ssvdag, SameUnitsWithOneAndTwoThreads) {
     EXPECT_EQ(builds[0].decode(), codes);
 }
 
-TEST(Ssvdag, EmptyAndSingleVoxelGrids) {
+TYPED_TEST(SymmetricDagTest, EmptyAndSingleVoxelGrids) {
     const Svdag empty_svdag = Svdag::from_voxels(gilab::test::unit_grid(8), std::vector<uint64_t>{});
-    const Ssvdag empty = Ssvdag::from_svdag(empty_svdag);
+    const TypeParam empty = TypeParam::from_svdag(empty_svdag);
     EXPECT_TRUE(empty.empty());
     EXPECT_TRUE(empty.decode().empty());
     EXPECT_EQ(empty.node_count(), 0u);
@@ -582,12 +622,12 @@ TEST(Ssvdag, EmptyAndSingleVoxelGrids) {
     EXPECT_EQ(empty.voxel_count(), 0u);
     EXPECT_FALSE(empty.contains_voxel({0, 0, 0}));
     EXPECT_FALSE(empty.occupied(Vec3(0.5f)));
-    for (const Ray& r : gilab::test::traversal_test_rays()) ASSERT_FALSE(cast_ssvdag_ray(empty, r).hit);
-    EXPECT_FALSE(cast_ssvdag_ray(Ssvdag{}, Ray{}).hit);
+    for (const Ray& r : gilab::test::traversal_test_rays()) ASSERT_FALSE(cast_symmetric_dag_ray(empty, r).hit);
+    EXPECT_FALSE(cast_symmetric_dag_ray(TypeParam{}, Ray{}).hit);
 
     const std::vector<uint64_t> one{0};
     const Svdag single_svdag = Svdag::from_voxels(gilab::test::unit_grid(1), one);
-    const Ssvdag single = Ssvdag::from_svdag(single_svdag);
+    const TypeParam single = TypeParam::from_svdag(single_svdag);
     EXPECT_FALSE(single.empty());
     EXPECT_EQ(single.depth(), 0);
     EXPECT_EQ(single.decode(), one);
@@ -596,22 +636,22 @@ TEST(Ssvdag, EmptyAndSingleVoxelGrids) {
     Ray r;
     r.origin = Vec3(0.5f, 0.5f, -1.0f);
     r.direction = Vec3(0, 0, 1);
-    const VoxelRayHit hit = cast_ssvdag_ray(single, r);
+    const VoxelRayHit hit = cast_symmetric_dag_ray(single, r);
     ASSERT_TRUE(hit.hit);
     EXPECT_FLOAT_EQ(hit.t, 1.0f);
     r.origin.x = 1.5f;
-    EXPECT_FALSE(cast_ssvdag_ray(single, r).hit);
+    EXPECT_FALSE(cast_symmetric_dag_ray(single, r).hit);
 }
 
 TEST(Ssvdag, PointersHold29BitAddressesAnd3BitMirrors) {
-    const uint32_t w = encode_ssvdag_pointer(kSsvdagAddressLimit - 1, 5);
-    EXPECT_EQ(decode_ssvdag_pointer(w), (SsvdagPointer{kSsvdagAddressLimit - 1, 5}));
-    EXPECT_EQ(decode_ssvdag_pointer(encode_ssvdag_pointer(12345, 0)), (SsvdagPointer{12345, 0}));
-    EXPECT_NE(gilab::test::error_of([] { encode_ssvdag_pointer(kSsvdagAddressLimit, 0); }).find("29 bits"),
+    const uint32_t w = Ssvdag::encode_long_pointer(Ssvdag::kAddressLimit - 1, 5);
+    EXPECT_EQ(Ssvdag::decode_long_pointer(w), (SymmetricDagPointer{Ssvdag::kAddressLimit - 1, 5}));
+    EXPECT_EQ(Ssvdag::decode_long_pointer(Ssvdag::encode_long_pointer(12345, 0)), (SymmetricDagPointer{12345, 0}));
+    EXPECT_NE(gilab::test::error_of([] { Ssvdag::encode_long_pointer(Ssvdag::kAddressLimit, 0); }).find("29 bits"),
               std::string::npos);
-    EXPECT_NE(gilab::test::error_of([] { encode_ssvdag_pointer(uint64_t(1) << 40, 1); }).find("29 bits"),
+    EXPECT_NE(gilab::test::error_of([] { Ssvdag::encode_long_pointer(uint64_t(1) << 40, 1); }).find("29 bits"),
               std::string::npos);
-    EXPECT_NE(gilab::test::error_of([] { encode_ssvdag_pointer(0, 8); }).find("3 bits"), std::string::npos);
+    EXPECT_NE(gilab::test::error_of([] { Ssvdag::encode_long_pointer(0, 8); }).find("not one of the 8 reflections"), std::string::npos);
     for (uint32_t m = 0; m < 8; ++m)
         for (uint32_t mask = 0; mask < 256; ++mask) {
             ASSERT_EQ(reflect_mask(reflect_mask(mask, m), m), mask) << "a reflection is its own inverse";
@@ -621,19 +661,84 @@ TEST(Ssvdag, PointersHold29BitAddressesAnd3BitMirrors) {
     EXPECT_EQ(reflect_mask(0b00000001, 6), 0b01000000);
 }
 
-TEST(Ssvdag, StatsReportTheStorage) {
+TYPED_TEST(SymmetricDagTest, StatsReportTheStorage) {
     const std::vector<uint64_t> codes = mixed_voxels(64);
     const Svdag svdag = Svdag::from_voxels(gilab::test::unit_grid(64), codes);
-    const Ssvdag dag = Ssvdag::from_svdag(svdag);
+    const TypeParam dag = TypeParam::from_svdag(svdag);
     const Stats s = dag.stats();
     EXPECT_EQ(s.get("nodes"), double(dag.node_count()));
     EXPECT_EQ(s.get("bytes"), double(dag.bytes()));
     EXPECT_EQ(s.get("pointers"), double(dag.pointer_count()));
-    EXPECT_EQ(s.get("mirrored_pointers"), double(dag.mirrored_pointer_count()));
+    EXPECT_EQ(s.get("transformed_pointers"), double(dag.transformed_pointer_count()));
     EXPECT_EQ(s.get("long_pointers"), double(dag.long_pointer_count()));
     EXPECT_EQ(s.get("word_bytes"), double(dag.word_bytes()));
     EXPECT_EQ(s.get("input_nodes"), double(svdag.node_count()));
     EXPECT_EQ(s.get("nodes_level_0"), 1.0);
     EXPECT_GE(s.get("convert_ms"), s.get("dedup_ms"));
     EXPECT_GT(s.get("table_bytes"), 0.0);
+}
+
+TEST(CubeSymmetricDag, AnAxisPermutedSubtreeSharesOneNode) {
+    // Octant 0 holds the asymmetric shape, octant 1 the same shape with x and y swapped:
+    // no reflection maps one onto the other, a permutation does.
+    std::vector<UVec3> voxels = kAsymmetric;
+    const auto swapped = shifted(transformed(kAsymmetric, 2 * 8, 4), octant_corner(1, 4));  // permutation (y, x, z)
+    voxels.insert(voxels.end(), swapped.begin(), swapped.end());
+    const std::vector<uint64_t> codes = sorted_codes(voxels);
+    const Svdag svdag = Svdag::from_voxels(gilab::test::unit_grid(8), codes);
+    const Ssvdag reflections = Ssvdag::from_svdag(svdag);
+    const CubeSymmetricDag dag = CubeSymmetricDag::from_svdag(svdag);
+    EXPECT_EQ(reflections.level_node_counts()[1], 2u) << "the reflections keep both shapes";
+    EXPECT_EQ(dag.level_node_counts()[1], 1u) << "a shape and its axis-swapped copy are one node";
+    EXPECT_EQ(dag.decode(), codes);
+    const auto a = dag.child(dag.root(), 0, 0), b = dag.child(dag.root(), 0, 1);
+    ASSERT_TRUE(a && b);
+    EXPECT_EQ(a->address, b->address);
+    // The two views differ by the x–y swap: b's transform is the swap after a's.
+    EXPECT_EQ(b->transform, CubeSymmetryGroup::compose(2 * 8, a->transform));
+    EXPECT_GE(dag.permuting_pointer_count(), 1u);
+    // Rays through the swapped octant walk it in the stored node's permuted slot order.
+    const DagWordsView view = dag_view(svdag);
+    int hits = 0;
+    for (const Ray& r : many_rays(8)) {
+        const VoxelRayHit want = cast_dag_ray(view, r), got = cast_symmetric_dag_ray(dag, r);
+        ASSERT_EQ(got.hit, want.hit);
+        ASSERT_EQ(got.voxel, want.voxel);
+        ASSERT_EQ(got.t, want.t);
+        hits += want.voxel.x >= 4 && want.hit;
+    }
+    EXPECT_GT(hits, 50) << "rays reach the swapped octant";
+}
+
+TEST(CubeSymmetricDag, NeverMoreNodesThanTheSsvdagOnAnyLevel) {
+    const auto path = gilab::test::shared_asset("bunny/stanford-bunny.obj");
+    std::vector<Svdag> dags;
+    for (uint32_t n : {32u, 64u}) dags.push_back(Svdag::from_voxels(gilab::test::unit_grid(n), mixed_voxels(n)));
+    if (path) {
+        const SceneFrame frame = load_mesh_file(*path).evaluate(0.0);
+        const VoxelGrid grid = VoxelGrid::enclosing(frame.bounds, 256);
+        dags.push_back(Svdag::from_voxels(grid, voxelize(frame, grid).codes));
+    }
+    bool fewer = false;
+    for (const Svdag& svdag : dags) {
+        const Ssvdag reflections = Ssvdag::from_svdag(svdag);
+        const CubeSymmetricDag cube = CubeSymmetricDag::from_svdag(svdag);
+        for (size_t l = 0; l < cube.level_node_counts().size(); ++l)
+            EXPECT_LE(cube.level_node_counts()[l], reflections.level_node_counts()[l]) << "level " << l;
+        EXPECT_LE(cube.word_bytes(), reflections.word_bytes());
+        fewer |= cube.node_count() < reflections.node_count();
+    }
+    EXPECT_TRUE(fewer) << "the permutations merge some subtree the reflections cannot";
+}
+
+TEST(CubeSymmetricDag, PointersHold26BitAddressesAnd6BitTransforms) {
+    using Dag = CubeSymmetricDag;
+    EXPECT_EQ(Dag::kShortOffsetLimit, 1u << 10);
+    const uint32_t w = Dag::encode_long_pointer(Dag::kAddressLimit - 1, 47);
+    EXPECT_EQ(Dag::decode_long_pointer(w), (SymmetricDagPointer{Dag::kAddressLimit - 1, 47}));
+    EXPECT_EQ(Dag::decode_long_pointer(Dag::encode_long_pointer(12345, 9)), (SymmetricDagPointer{12345, 9}));
+    EXPECT_NE(gilab::test::error_of([] { Dag::encode_long_pointer(Dag::kAddressLimit, 0); }).find("26 bits"),
+              std::string::npos);
+    EXPECT_NE(gilab::test::error_of([] { Dag::encode_long_pointer(0, 48); }).find("not one of the 48 cube symmetries"),
+              std::string::npos);
 }
