@@ -110,4 +110,38 @@ inline std::vector<Ray> traversal_test_rays() {
     return rays;
 }
 
+// Random triangles and a sphere in the unit cube: the DAG ray casters' test scene.
+inline TriangleSoup clutter_and_sphere(uint32_t seed) {
+    std::mt19937 rng(seed);
+    TriangleSoup soup = random_triangles(rng, 24, Vec3(0.05f), Vec3(0.95f));
+    const TriangleSoup sphere = uv_sphere(Vec3(0.45f, 0.4f, 0.55f), 0.2f, 12, 24);
+    const uint32_t base = uint32_t(soup.positions.size());
+    soup.positions.insert(soup.positions.end(), sphere.positions.begin(), sphere.positions.end());
+    for (UVec3 t : sphere.triangles) soup.triangles.push_back(t + UVec3(base));
+    return soup;
+}
+
+// Resolution 48 (an octree of 64) on a grid at (-2, 5, 1) with side 3: neither at the
+// origin nor a power of two.
+inline VoxelGrid offset_grid() {
+    VoxelGrid grid;
+    grid.origin = Vec3(-2.0f, 5.0f, 1.0f);
+    grid.extent = 3.0f;
+    grid.resolution = 48;
+    return grid;
+}
+
+// A mesh and rays set up in the unit cube, moved onto `grid`.
+inline TriangleSoup moved_onto(TriangleSoup soup, const VoxelGrid& grid) {
+    for (Vec3& p : soup.positions) p = grid.origin + p * grid.extent;
+    return soup;
+}
+inline std::vector<Ray> moved_onto(std::vector<Ray> rays, const VoxelGrid& grid) {
+    for (Ray& r : rays) {
+        r.origin = grid.origin + r.origin * grid.extent;
+        r.direction *= grid.extent;
+    }
+    return rays;
+}
+
 }  // namespace gilab::test

@@ -10,6 +10,7 @@
 #include "core/util/morton.hpp"
 
 namespace gilab {
+
 template <class Group>
 uint32_t SymmetricDag<Group>::encode_long_pointer(uint64_t address, uint32_t transform) {
     if (address >= kAddressLimit)

@@ -61,16 +61,6 @@ void expect_close_agreement(const Agreement& a, const std::string& what) {
     EXPECT_GE(a.same_visits, a.rays - a.rays / 100) << what;
 }
 
-TriangleSoup clutter_and_sphere(uint32_t seed) {
-    std::mt19937 rng(seed);
-    TriangleSoup soup = gilab::test::random_triangles(rng, 24, Vec3(0.05f), Vec3(0.95f));
-    const TriangleSoup sphere = gilab::test::uv_sphere(Vec3(0.45f, 0.4f, 0.55f), 0.2f, 12, 24);
-    const uint32_t base = uint32_t(soup.positions.size());
-    soup.positions.insert(soup.positions.end(), sphere.positions.begin(), sphere.positions.end());
-    for (UVec3 t : sphere.triangles) soup.triangles.push_back(t + UVec3(base));
-    return soup;
-}
-
 void check_svdag(const Svdag& dag, const std::vector<uint64_t>& codes, const std::vector<Ray>& rays,
                  const std::string& what) {
     const auto occupied = [&](const UVec3& v) {
@@ -85,7 +75,7 @@ void check_svdag(const Svdag& dag, const std::vector<uint64_t>& codes, const std
 TEST(DagRayCaster, MatchesTheReferenceWalkAtSeveralDepths) {
     for (uint32_t resolution : {8u, 64u, 512u}) {
         const VoxelGrid grid = gilab::test::unit_grid(resolution);
-        const TriangleSoup soup = clutter_and_sphere(3);
+        const TriangleSoup soup = gilab::test::clutter_and_sphere(3);
         const std::vector<uint64_t> codes = voxelize(soup.positions, soup.triangles, grid).codes;
         check_svdag(Svdag::from_voxels(grid, codes), codes, gilab::test::traversal_test_rays(),
                     std::to_string(resolution) + "³");
@@ -98,25 +88,17 @@ TEST(DagRayCaster, MatchesOnRandomVoxelsAndAnOffsetGridThatIsNotAPowerOfTwo) {
     const std::vector<uint64_t> random = gilab::test::random_voxels(rng, 32, 0.01);
     check_svdag(Svdag::from_voxels(unit, random), random, gilab::test::traversal_test_rays(), "random voxels");
 
-    // Resolution 48 (an octree of 64), a grid at (-2, 5, 1) with side 3: the rays move with it.
-    VoxelGrid grid;
-    grid.origin = Vec3(-2.0f, 5.0f, 1.0f);
-    grid.extent = 3.0f;
-    grid.resolution = 48;
-    TriangleSoup soup = clutter_and_sphere(9);
-    for (Vec3& p : soup.positions) p = grid.origin + p * grid.extent;
+    // The offset grid: the rays move with it.
+    const VoxelGrid grid = gilab::test::offset_grid();
+    const TriangleSoup soup = gilab::test::moved_onto(gilab::test::clutter_and_sphere(9), grid);
     const std::vector<uint64_t> codes = voxelize(soup.positions, soup.triangles, grid).codes;
-    std::vector<Ray> rays = gilab::test::traversal_test_rays();
-    for (Ray& r : rays) {
-        r.origin = grid.origin + r.origin * grid.extent;
-        r.direction *= grid.extent;
-    }
+    const std::vector<Ray> rays = gilab::test::moved_onto(gilab::test::traversal_test_rays(), grid);
     check_svdag(Svdag::from_voxels(grid, codes), codes, rays, "offset 48³ grid");
 }
 
 TEST(DagRayCaster, StopsAtTmaxLikeTheReference) {
     const VoxelGrid grid = gilab::test::unit_grid(64);
-    const TriangleSoup soup = clutter_and_sphere(5);
+    const TriangleSoup soup = gilab::test::clutter_and_sphere(5);
     const std::vector<uint64_t> codes = voxelize(soup.positions, soup.triangles, grid).codes;
     const Svdag dag = Svdag::from_voxels(grid, codes);
     std::vector<Ray> rays = gilab::test::traversal_test_rays();
@@ -137,7 +119,7 @@ TEST(DagRayCaster, EveryFrameOfAMultiFrameDagMatches) {
     MultiFrameDag builder(grid);
     std::vector<std::vector<uint64_t>> frames;
     for (uint32_t seed : {1u, 2u, 1u}) {
-        const TriangleSoup soup = clutter_and_sphere(seed);
+        const TriangleSoup soup = gilab::test::clutter_and_sphere(seed);
         frames.push_back(voxelize(soup.positions, soup.triangles, grid).codes);
         builder.append_frame(frames.back());
     }

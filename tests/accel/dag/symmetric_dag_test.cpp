@@ -55,12 +55,6 @@ std::vector<uint64_t> centred_sphere_voxels(uint32_t n) {
     return voxelize(m.positions, m.triangles, gilab::test::unit_grid(n)).codes;
 }
 
-TriangleSoup clutter_and_sphere(uint32_t seed) {
-    std::mt19937 rng(seed);
-    return merged({gilab::test::random_triangles(rng, 24, Vec3(0.05f), Vec3(0.95f)),
-                   gilab::test::uv_sphere(Vec3(0.45f, 0.4f, 0.55f), 0.2f, 12, 24)});
-}
-
 std::vector<uint64_t> sorted_codes(std::vector<UVec3> voxels) {
     std::vector<uint64_t> codes;
     for (const UVec3& v : voxels) codes.push_back(morton_encode(v));
@@ -508,12 +502,7 @@ void check_shared_mesh(const std::string& asset, std::initializer_list<uint32_t>
         EXPECT_LT(dag.bytes(), dag.word_bytes()) << what << ": short pointers save bytes";
         expect_same_points(svdag, dag, codes, n);
         // The shared rays are set up for the unit cube: move them onto the grid.
-        std::vector<Ray> rays = many_rays(n);
-        for (Ray& r : rays) {
-            r.origin = grid.origin + r.origin * grid.extent;
-            r.direction *= grid.extent;
-        }
-        expect_same_rays(svdag, dag, rays, what);
+        expect_same_rays(svdag, dag, gilab::test::moved_onto(many_rays(n), grid), what);
     }
 }
 
@@ -538,7 +527,7 @@ TYPED_TEST(SymmetricDagTest, PointQueriesMatchTheSvdag) {
 TYPED_TEST(SymmetricDagTest, RayCastsMatchCastDagRay) {
     for (uint32_t resolution : {4u, 8u, 64u, 512u}) {
         const VoxelGrid grid = gilab::test::unit_grid(resolution);
-        const TriangleSoup soup = clutter_and_sphere(3);
+        const TriangleSoup soup = gilab::test::clutter_and_sphere(3);
         const Svdag svdag = Svdag::from_voxels(grid, voxelize(soup.positions, soup.triangles, grid).codes);
         expect_same_rays(svdag, TypeParam::from_svdag(svdag), many_rays(resolution), std::to_string(resolution) + "³");
     }
@@ -550,19 +539,11 @@ TYPED_TEST(SymmetricDagTest, RayCastsMatchCastDagRay) {
     const Svdag sphere = Svdag::from_voxels(gilab::test::unit_grid(128), centred_sphere_voxels(128));
     expect_same_rays(sphere, TypeParam::from_svdag(sphere), many_rays(128), "centred sphere");
 
-    // Resolution 48 (an octree of 64) on a grid at (-2, 5, 1) with side 3: rays move with it.
-    VoxelGrid grid;
-    grid.origin = Vec3(-2.0f, 5.0f, 1.0f);
-    grid.extent = 3.0f;
-    grid.resolution = 48;
-    TriangleSoup soup = clutter_and_sphere(9);
-    for (Vec3& p : soup.positions) p = grid.origin + p * grid.extent;
+    // The offset grid: the rays move with it.
+    const VoxelGrid grid = gilab::test::offset_grid();
+    const TriangleSoup soup = gilab::test::moved_onto(gilab::test::clutter_and_sphere(9), grid);
     const Svdag offset = Svdag::from_voxels(grid, voxelize(soup.positions, soup.triangles, grid).codes);
-    std::vector<Ray> rays = many_rays(48);
-    for (Ray& r : rays) {
-        r.origin = grid.origin + r.origin * grid.extent;
-        r.direction *= grid.extent;
-    }
+    const std::vector<Ray> rays = gilab::test::moved_onto(many_rays(48), grid);
     expect_same_rays(offset, TypeParam::from_svdag(offset), rays, "offset 48³ grid");
 }
 
