@@ -168,17 +168,17 @@ void expect_one_node_per_class(const Svdag& svdag, const Dag& dag) {
     using Group = typename Dag::SymmetryGroup;
     for (int l = 0; l < dag.depth(); ++l) {
         const uint32_t side = 1u << (dag.depth() - l);
-        std::set<std::vector<uint64_t>> svdag_classes, ssvdag_classes;
+        std::set<std::vector<uint64_t>> svdag_classes, dag_classes;
         for (uint32_t a : svdag.level_nodes(l))
             svdag_classes.insert(symmetry_class<Group>(svdag_subtree(svdag, a, l), side));
         const std::vector<uint32_t> nodes = dag.level_nodes(l);
         ASSERT_EQ(nodes.size(), dag.level_node_counts()[l]);
         for (uint32_t a : nodes) {
             const auto cls = symmetry_class<Group>(symmetric_dag_subtree(dag, SymmetricDagPointer{a, 0}, l), side);
-            EXPECT_TRUE(ssvdag_classes.insert(cls).second) << "level " << l << ": two nodes are images of each other";
+            EXPECT_TRUE(dag_classes.insert(cls).second) << "level " << l << ": two nodes are images of each other";
             EXPECT_TRUE(svdag_classes.count(cls)) << "level " << l << ": a node of no SVDAG subtree";
         }
-        EXPECT_EQ(ssvdag_classes.size(), svdag_classes.size()) << "level " << l;
+        EXPECT_EQ(dag_classes.size(), svdag_classes.size()) << "level " << l;
     }
 }
 
@@ -210,7 +210,7 @@ template <class Dag>
 void check_storage(const Dag& dag) {
     ASSERT_FALSE(dag.empty());
     const auto units = dag.units();
-    size_t pointers = 0, mirrored = 0, long_pointers = 0, interior_units = 0, words = 0;
+    size_t pointers = 0, transformed = 0, long_pointers = 0, interior_units = 0, words = 0;
     for (int l = 0; l + 1 < dag.depth(); ++l) {
         const bool to_leaves = l + 2 == dag.depth();
         const uint32_t below_begin = to_leaves ? 0 : dag.level_begin(l + 1);
@@ -228,7 +228,7 @@ void check_storage(const Dag& dag) {
                 EXPECT_EQ(is_long, p.address - below_begin >= Dag::kShortOffsetLimit)
                     << "level " << l << ": a pointer is short exactly when its child is within reach";
                 ++references[p.address];
-                mirrored += p.transform != 0;
+                transformed += p.transform != 0;
                 long_pointers += is_long;
                 ++pointers;
             }
@@ -245,7 +245,7 @@ void check_storage(const Dag& dag) {
     }
     EXPECT_EQ(dag.leaf_begin(), interior_units);
     EXPECT_EQ(pointers, dag.pointer_count());
-    EXPECT_EQ(mirrored, dag.transformed_pointer_count());
+    EXPECT_EQ(transformed, dag.transformed_pointer_count());
     EXPECT_EQ(long_pointers, dag.long_pointer_count());
     const size_t leaves = dag.level_node_counts()[dag.depth() - 1];
     EXPECT_LE(leaves, mask_classes<typename Dag::SymmetryGroup>()) << "one node per class of non-empty masks";
