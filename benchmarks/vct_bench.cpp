@@ -2,7 +2,8 @@
 // (6 levels of 32³) and the dense mip texture (128³) of the same scene with the same
 // finest voxel, so each phase compares like for like:
 //  - BM_ConeMarch: 16 diffuse cones from each of 96×96 G-buffer points (primary hits of
-//    the scene camera), traced as the technique's final gather traces them;
+//    the scene camera), traced cone by cone or as one fan per point (eight cones at a
+//    time under the AVX2 kernel), as the technique's final gather traces them;
 //  - BM_ConeMarchLayout: the same on one thread with the radiance laid out as the
 //    technique stores it (a voxel's six faces together) or as P3's Fig. 2 (one block
 //    per face), with and without skipping samples the occupancy map marks empty;
@@ -158,18 +159,27 @@ void set_structure_label(benchmark::State& state, int structure, int threads, co
                    (threads > 0 ? std::to_string(threads) + " thread(s)" : std::string("all cores")) + more);
 }
 
-// One pass over every G-buffer point's diffuse cones; returns the samples taken.
+// One pass over every G-buffer point's diffuse cones, cone by cone or as one fan per
+// point (trace_cone_fan, as the technique traces them); returns the samples taken.
 uint64_t march_all(const VoxelConeView& view, const SponzaScene& s, const ConeSet& set,
-                   const std::vector<PointCones>& setup, ConeKernel kernel) {
+                   const std::vector<PointCones>& setup, ConeKernel kernel, bool fans) {
     std::atomic<uint64_t> samples{0};
     parallel_for(s.points.size(), 64, [&](size_t b, size_t e) {
         uint64_t local = 0;
         Vec3 sum(0);
+        std::vector<Vec3> directions(set.directions.size());
+        std::vector<ConeResult> results(set.directions.size());
         for (size_t i = b; i < e; ++i) {
             const Frame frame(s.points[i].normal);
-            for (size_t c = 0; c < set.directions.size(); ++c) {
-                const Cone cone{setup[i].apex, frame.to_world(set.directions[c]), set.tan_half_angle};
-                const ConeResult r = trace_cone(view, cone, setup[i].options, kernel);
+            for (size_t c = 0; c < set.directions.size(); ++c) directions[c] = frame.to_world(set.directions[c]);
+            if (fans) {
+                trace_cone_fan(view, setup[i].apex, directions, set.tan_half_angle, setup[i].options, results, kernel);
+            } else {
+                for (size_t c = 0; c < set.directions.size(); ++c)
+                    results[c] = trace_cone(view, Cone{setup[i].apex, directions[c], set.tan_half_angle},
+                                            setup[i].options, kernel);
+            }
+            for (const ConeResult& r : results) {
                 sum += r.radiance;
                 local += uint64_t(r.samples);
             }
@@ -181,14 +191,14 @@ uint64_t march_all(const VoxelConeView& view, const SponzaScene& s, const ConeSe
 }
 
 void time_march(benchmark::State& state, const VoxelConeView& view, const VctTechnique& t,
-                ConeKernel kernel = best_cone_kernel()) {
+                ConeKernel kernel = best_cone_kernel(), bool fans = false) {
     const SponzaScene& s = *sponza();
     const ConeSet set = hemisphere_cones(kDiffuseCones);
     std::vector<PointCones> setup;
     for (const GbufferPoint& p : s.points) setup.push_back(cones_at(view, t.settings(), s.bounds, p));
-    const uint64_t per_pass = march_all(view, s, set, setup, kernel);  // warm-up, outside the timed loop
+    const uint64_t per_pass = march_all(view, s, set, setup, kernel, fans);  // warm-up, outside the timed loop
     uint64_t total = 0;
-    for (auto _ : state) total += march_all(view, s, set, setup, kernel);
+    for (auto _ : state) total += march_all(view, s, set, setup, kernel, fans);
     const double cones = double(s.points.size()) * double(set.directions.size());
     state.counters["points"] = double(s.points.size());
     state.counters["samples_per_cone"] = double(per_pass) / cones;
@@ -202,15 +212,17 @@ void BM_ConeMarch(benchmark::State& state) {
     if (!need_sponza(state)) return;
     const int structure = int(state.range(0)), threads = int(state.range(1));
     const ConeKernel kernel = state.range(2) ? ConeKernel::avx2 : ConeKernel::portable;
+    const bool fans = state.range(3) != 0;
     if (!kernel_available(state, kernel)) return;
     VctTechnique& t = technique(structure);
     ThreadLimit limit(threads);
-    time_march(state, t.radiance_view(), t, kernel);
-    set_structure_label(state, structure, threads, std::string(", ") + to_string(kernel) + " kernel");
+    time_march(state, t.radiance_view(), t, kernel, fans);
+    set_structure_label(state, structure, threads,
+                        std::string(", ") + to_string(kernel) + " kernel" + (fans ? ", fans" : ", cone by cone"));
 }
 BENCHMARK(BM_ConeMarch)
-    ->ArgsProduct({{0, 1}, {1, 0}, {0, 1}})
-    ->ArgNames({"structure", "threads", "kernel"})
+    ->ArgsProduct({{0, 1}, {1, 0}, {0, 1}, {0, 1}})
+    ->ArgNames({"structure", "threads", "kernel", "fan"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -384,6 +384,20 @@ ConeResult trace_cone_avx2(const VoxelConeView& view, const Cone& cone, const Co
     return avx2_kernel::march<sample_avx2_inline>(view, cone, options);
 }
 
+namespace avx2_kernel {
+#define GILAB_FAN_INLINE [[gnu::always_inline]] inline
+#include "techniques/vct/cone_fan.inc"
+#undef GILAB_FAN_INLINE
+}  // namespace avx2_kernel
+
+void trace_fan_avx2(const VoxelConeView& view, const Vec3& apex, std::span<const Vec3> directions,
+                    float tan_half_angle, const ConeOptions& options, std::span<ConeResult> results) {
+    for (size_t b = 0; b < directions.size(); b += 8)
+        avx2_kernel::march_fan8<sample_avx2_inline>(view, apex, directions.data() + b,
+                                                    int(std::min<size_t>(8, directions.size() - b)), tan_half_angle,
+                                                    options, results.data() + b);
+}
+
 #if defined(__clang__)
 #pragma clang attribute pop
 #else
@@ -442,6 +456,25 @@ ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOpt
 
 ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOptions& options) {
     return trace_with(best_cone_kernel(), view, cone, options);
+}
+
+void trace_cone_fan(const VoxelConeView& view, const Vec3& apex, std::span<const Vec3> directions,
+                    float tan_half_angle, const ConeOptions& options, std::span<ConeResult> results,
+                    ConeKernel kernel) {
+    require_supported(kernel);
+    if (results.size() != directions.size())
+        throw Error("cone tracer", "a fan of " + std::to_string(directions.size()) + " cones needs as many results, got " +
+                                       std::to_string(results.size()));
+#if GILAB_CONE_AVX2
+    if (kernel == ConeKernel::avx2) return trace_fan_avx2(view, apex, directions, tan_half_angle, options, results);
+#endif
+    for (size_t i = 0; i < directions.size(); ++i)
+        results[i] = trace_cone_portable(view, Cone{apex, directions[i], tan_half_angle}, options);
+}
+
+void trace_cone_fan(const VoxelConeView& view, const Vec3& apex, std::span<const Vec3> directions,
+                    float tan_half_angle, const ConeOptions& options, std::span<ConeResult> results) {
+    trace_cone_fan(view, apex, directions, tan_half_angle, options, results, best_cone_kernel());
 }
 
 ConeSet hemisphere_cones(int count) {

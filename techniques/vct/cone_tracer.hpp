@@ -26,6 +26,7 @@
 // trilinear footprint of a coarse level; the optional clip plane (the surface's tangent
 // plane) removes voxels behind it and the back-facing faces of voxels it cuts.
 #include <algorithm>
+#include <span>
 #include <vector>
 #include "accel/vct/anisotropic_voxel.hpp"
 #include "accel/vct/cascaded_voxel_texture.hpp"
@@ -67,6 +68,7 @@ public:
     int level_count() const { return int(levels_.size()); }
     float base_voxel_size() const { return levels_.empty() ? 1.0f : levels_[0].voxel_size; }
     const Vec3& anchor() const { return anchor_; }  // world position of voxel (0, 0, 0)'s corner
+    bool nested() const { return nested_; }         // cascades (own regions) or mips (level 0's region)
     const ConeLevel& level(int k) const { return levels_[size_t(k)]; }
     // Finest level whose region holds p at least `margin` voxels inside; -1 if none.
     int finest_level_containing(const Vec3& p, float margin = 1.0f) const {
@@ -143,6 +145,16 @@ inline float cone_level(float diameter, float base_voxel_size) {
 ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOptions& options);  // best kernel
 // With a chosen kernel (Error if this CPU lacks it).
 ConeResult trace_cone(const VoxelConeView& view, const Cone& cone, const ConeOptions& options, ConeKernel kernel);
+
+// A fan: cones that share apex, aperture and options (a surface point's diffuse cones, a
+// voxel side's bounce cones). results[i] is trace_cone's result for directions[i], bit for
+// bit; the AVX2 kernel marches the fan eight cones at a time, the loop's bookkeeping eight
+// lanes wide. `results` must be as long as `directions`.
+void trace_cone_fan(const VoxelConeView& view, const Vec3& apex, std::span<const Vec3> directions,
+                    float tan_half_angle, const ConeOptions& options, std::span<ConeResult> results);
+void trace_cone_fan(const VoxelConeView& view, const Vec3& apex, std::span<const Vec3> directions,
+                    float tan_half_angle, const ConeOptions& options, std::span<ConeResult> results,
+                    ConeKernel kernel);
 
 // Fixed cones over the hemisphere around +z (P3: 16 cones): equal solid angle 2π/N each
 // (axes on a spiral, uniform in cos θ), half aperture with that solid angle. The weights

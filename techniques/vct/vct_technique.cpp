@@ -167,6 +167,9 @@ struct Shading {
             position[size_t(g)] += fi.opacity * fi.position;
             weight[size_t(g)] += fi.opacity;
         }
+        const size_t cone_count = injection_set.directions.size();
+        std::vector<Vec3> directions(cone_count);
+        std::vector<ConeResult> results(cone_count);
         for (int g = 0; g < kFaceCount; ++g) {
             if (!(weight[size_t(g)] > 0)) continue;
             const float n_length = glm::length(normal[size_t(g)]);
@@ -177,12 +180,12 @@ struct Shading {
             ConeOptions o = options;
             o.clip = settings.clip_plane;
             o.clip_plane = Vec4(n, glm::dot(n, x));
-            for (size_t c = 0; c < injection_set.directions.size(); ++c) {
-                Cone cone{x + settings.cone_offset * voxel * n, frame.to_world(injection_set.directions[c]),
-                          injection_set.tan_half_angle};
-                ConeResult r = trace_cone(view, cone, o);
-                E[g] += r.radiance * (injection_set.cosines[c] * injection_set.weights[c]);
-                cones += uint64_t(r.samples) << 32 | 1u;  // samples in the high half
+            for (size_t c = 0; c < cone_count; ++c) directions[c] = frame.to_world(injection_set.directions[c]);
+            trace_cone_fan(view, x + settings.cone_offset * voxel * n, directions, injection_set.tan_half_angle, o,
+                           results);
+            for (size_t c = 0; c < cone_count; ++c) {
+                E[g] += results[c].radiance * (injection_set.cosines[c] * injection_set.weights[c]);
+                cones += uint64_t(results[c].samples) << 32 | 1u;  // samples in the high half
             }
         }
         for (int f = 0; f < kFaceCount; ++f) {
@@ -760,6 +763,9 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
                               size_t((width + ts - 1) / ts) * size_t((height + ts - 1) / ts));
             parallel_for_tiles(width, height, ts, [&](const Tile& tile) {
                 uint64_t local = 0, samples = 0;
+                const size_t cone_count = diffuse_set_.directions.size();
+                std::vector<Vec3> directions(cone_count);
+                std::vector<ConeResult> results(cone_count);
                 for (int y = tile.y0; y < tile.y1; ++y)
                     for (int x = tile.x0; x < tile.x1; ++x) {
                         const size_t i = size_t(y) * size_t(width) + size_t(x);
@@ -768,12 +774,12 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
                         const SurfaceMaterial& m = ph.surface;
                         const SurfaceCones sc = cones_at(ph);
                         const Frame frame(ph.normal);
+                        for (size_t c = 0; c < cone_count; ++c) directions[c] = frame.to_world(diffuse_set_.directions[c]);
+                        trace_cone_fan(view, sc.apex, directions, diffuse_set_.tan_half_angle, sc.options, results);
                         Vec3 E(0);
                         float occlusion = 0;
-                        for (size_t c = 0; c < diffuse_set_.directions.size(); ++c) {
-                            Cone cone{sc.apex, frame.to_world(diffuse_set_.directions[c]),
-                                      diffuse_set_.tan_half_angle};
-                            ConeResult r = trace_cone(view, cone, sc.options);
+                        for (size_t c = 0; c < cone_count; ++c) {
+                            const ConeResult& r = results[c];
                             const float w = diffuse_set_.cosines[c] * diffuse_set_.weights[c];
                             E += r.radiance * w;
                             occlusion += r.occlusion * w;

@@ -247,6 +247,71 @@ TEST(ConeTracer, KernelsAgree) {
     }
 }
 
+// A fan (cones from one apex with one aperture and options) gives each cone exactly
+// trace_cone's result, with either kernel, on cascades and a dense mip chain, for fans of
+// 1 to 16 cones (the AVX2 kernel's eight lanes, part-filled and full), with the clip
+// plane, level blending, opacity correction, the bounding box and a distance limit each
+// on and off. Apexes lie all over the levels, outside them too, so lanes leave the
+// finest levels, the box and the structure at different samples.
+TEST(ConeTracer, FansGiveEachConeItsOwnResult) {
+    Scene scene = make_cornell_box();
+    std::vector<ConeKernel> kernels{ConeKernel::portable};
+    if (best_cone_kernel() == ConeKernel::avx2) kernels.push_back(ConeKernel::avx2);
+    for (const char* structure : {"cascaded", "dense"}) {
+        auto vct = prepared(scene, {{"structure", structure}, {"dense_resolution", 64}});
+        render_one(*vct, inside_camera(16));
+        const VoxelConeView view = vct->radiance_view();
+        // A box smaller than the structure (level 1's region), so cones leave it first.
+        const ConeLevel& inner = view.level(std::min(1, view.level_count() - 1));
+        Bounds3 box;
+        box.min = view.anchor() + Vec3(inner.origin) * inner.voxel_size;
+        box.max = box.min + Vec3(float(inner.size) * inner.voxel_size);
+        Rng rng(5, 3);
+        int compared = 0, lit = 0;
+        for (int i = 0; i < 300; ++i) {
+            const int k = std::min(int(rng.uniform() * float(view.level_count())), view.level_count() - 1);
+            const ConeLevel& l = view.level(k);
+            const Vec3 u(rng.uniform(), rng.uniform(), rng.uniform());
+            const Vec3 apex = view.anchor() + (Vec3(l.origin) + (u * 1.2f - Vec3(0.1f)) * float(l.size)) * l.voxel_size;
+            const Vec3 n = glm::normalize(Vec3(rng.uniform(), rng.uniform(), rng.uniform()) - Vec3(0.5f) + Vec3(1e-3f));
+            const int count = 1 + i % 16;
+            std::vector<Vec3> directions;
+            for (int c = 0; c < count; ++c)
+                directions.push_back(glm::normalize(n + Vec3(rng.uniform(), rng.uniform(), rng.uniform()) - Vec3(0.5f)));
+            ConeOptions o;
+            o.start = (0.5f + 2.0f * rng.uniform()) * view.base_voxel_size();
+            o.clip = i % 2 == 0;
+            o.clip_plane = Vec4(n, glm::dot(n, apex) - 0.3f * l.voxel_size);
+            o.blend_levels = i % 3 != 0;
+            o.correct_opacity = i % 5 == 0;
+            if (i % 4 != 3) o.bounds = box;
+            if (i % 7 == 0) o.max_distance = 0.5f * glm::length(box.max - box.min);
+            o.lod_bias = i % 6 == 0 ? -0.5f : 0.0f;
+            const float tan_half = 0.1f + 0.9f * rng.uniform();
+            for (ConeKernel kernel : kernels) {
+                std::vector<ConeResult> fan(directions.size());
+                trace_cone_fan(view, apex, directions, tan_half, o, fan, kernel);
+                for (int c = 0; c < count; ++c) {
+                    const ConeResult one = trace_cone(view, Cone{apex, directions[size_t(c)], tan_half}, o, kernel);
+                    const ConeResult& f = fan[size_t(c)];
+                    ASSERT_EQ(f.samples, one.samples) << structure << " fan " << i << " cone " << c << " " << to_string(kernel);
+                    ASSERT_EQ(f.radiance, one.radiance) << structure << " fan " << i << " cone " << c << " " << to_string(kernel);
+                    ASSERT_EQ(f.opacity, one.opacity) << structure << " fan " << i << " cone " << c;
+                    ASSERT_EQ(f.occlusion, one.occlusion) << structure << " fan " << i << " cone " << c;
+                    ++compared;
+                    lit += one.opacity > 0.01f;
+                }
+            }
+        }
+        EXPECT_GT(lit, compared / 10) << structure << ": too few cones saw anything for the comparison to mean much";
+    }
+    std::vector<ConeResult> short_results(1);
+    const std::vector<Vec3> two{Vec3(0, 0, 1), Vec3(0, 1, 0)};
+    const CascadedVoxelTexture empty = constant_levels(0.0f);
+    EXPECT_THROW(trace_cone_fan(VoxelConeView::cascade(empty, empty.radiance), Vec3(0.0f), two, 0.3f, {}, short_results),
+                 Error);
+}
+
 // Levels above 512³ voxels take the portable sampler under the AVX2 kernel (its 32-bit
 // cells would not hold them): there the two kernels agree bit for bit, while on a level
 // of 512³ over the same texels the AVX2 sums, rounded otherwise, differ somewhere.
