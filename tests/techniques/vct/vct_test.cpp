@@ -350,6 +350,68 @@ TEST(ConeTracer, LevelsAbove512TakeThePortableSampler) {
     }
 }
 
+// Views the fans' eight-lane level tables cannot hold take each lane's sample from the
+// kernel's own sampler: ten nested levels (more than eight lanes of levels) and a level of
+// 4096³ (cells beyond 32 bits). There too every cone of a fan gets trace_cone's result.
+TEST(ConeTracer, FansOverTenLevelsAndAbove512) {
+    if (best_cone_kernel() != ConeKernel::avx2) GTEST_SKIP() << "this CPU lacks AVX2, FMA or F16C: one kernel only";
+    constexpr int kStored = 16;  // a toroidal store of 16³ texels behind every level
+    std::vector<HalfRGBA> texels(size_t(kStored) * kStored * kStored * kFaceCount);
+    Rng rng(9, 4);
+    for (HalfRGBA& t : texels) {
+        const float a = rng.uniform() < 0.95f ? 0.0f : 0.1f * rng.uniform();
+        t = to_half_rgba(Vec4(a * rng.uniform(), a * rng.uniform(), a * rng.uniform(), a));
+    }
+    auto level = [&](int size, int origin, float voxel) {
+        ConeLevel l;
+        l.data = texels.data();
+        l.x_stride = kFaceCount;
+        l.row_stride = size_t(kStored) * kFaceCount;
+        l.slice_stride = size_t(kStored) * kStored * kFaceCount;
+        l.origin = IVec3(origin);
+        l.size = size;
+        l.wrap_mask = kStored - 1;
+        l.voxel_size = voxel;
+        l.inv_voxel_size = 1.0f / voxel;
+        return l;
+    };
+    std::vector<ConeLevel> ten;
+    for (int k = 0; k < 10; ++k) ten.push_back(level(32, -16, std::ldexp(1.0f, k)));
+    const VoxelConeView views[] = {VoxelConeView::of_levels(Vec3(0.0f), true, ten),
+                                   VoxelConeView::of_levels(Vec3(0.0f), true, {level(4096, -2048, 1.0f)})};
+    int compared = 0, lit = 0, coarse = 0;
+    for (const VoxelConeView& view : views) {
+        for (int i = 0; i < 60; ++i) {
+            const Vec3 apex = (Vec3(rng.uniform(), rng.uniform(), rng.uniform()) - Vec3(0.5f)) * 20.0f;
+            const Vec3 n = glm::normalize(Vec3(rng.uniform(), rng.uniform(), rng.uniform()) - Vec3(0.5f) + Vec3(1e-3f));
+            std::vector<Vec3> directions;
+            for (int c = 0; c < 16; ++c)
+                directions.push_back(glm::normalize(n + Vec3(rng.uniform(), rng.uniform(), rng.uniform()) - Vec3(0.5f)));
+            ConeOptions o;
+            o.clip = i % 2 == 0;
+            o.clip_plane = Vec4(n, glm::dot(n, apex) - 0.3f);
+            o.blend_levels = i % 3 == 0;
+            o.max_distance = 3000.0f;
+            // Narrow cones reach levels 8 and 9 while their footprint asks for a finer one.
+            const float tan_half = i % 4 == 1 ? 0.02f : 0.2f + rng.uniform();
+            std::vector<ConeResult> fan(directions.size());
+            trace_cone_fan(view, apex, directions, tan_half, o, fan, ConeKernel::avx2);
+            for (size_t c = 0; c < directions.size(); ++c) {
+                const ConeResult one = trace_cone(view, Cone{apex, directions[c], tan_half}, o, ConeKernel::avx2);
+                ASSERT_EQ(fan[c].samples, one.samples) << "view " << (&view - views) << " fan " << i << " cone " << c;
+                ASSERT_EQ(fan[c].radiance, one.radiance) << "view " << (&view - views) << " fan " << i << " cone " << c;
+                ASSERT_EQ(fan[c].opacity, one.opacity);
+                ASSERT_EQ(fan[c].occlusion, one.occlusion);
+                ++compared;
+                lit += one.opacity > 0.01f;
+                coarse += one.samples > 40;
+            }
+        }
+    }
+    EXPECT_GT(lit, compared / 10) << "too few cones saw anything for the comparison to mean much";
+    EXPECT_GT(coarse, 0) << "no cone marched far enough to reach the coarse levels";
+}
+
 // ---------------------------------------------------------------------------------
 
 // The Cornell box's diffuse indirect against the path tracer's indirect with the same
