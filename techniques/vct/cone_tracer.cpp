@@ -133,7 +133,7 @@ struct ClipGeometry {
 [[gnu::always_inline]] inline float clip_half_width(const ConeLevel& l, const Vec4& plane) {
     return 0.501f * l.voxel_size * (std::abs(plane.x) + std::abs(plane.y) + std::abs(plane.z));
 }
-// n[a] × the coordinate a of voxel i's centre: one float, or four lanes (GCC and Clang
+// n[a] × the coordinate a of voxel i's centre: one float, or four or eight lanes (GCC and Clang
 // vector types take the same operators), so both kernels compute it alike.
 template <class T>
 [[gnu::always_inline]] inline T clip_centre_term(T n, T anchor, T i, T voxel_size, T half) {
@@ -284,11 +284,105 @@ GILAB_AVX2_INLINE __m256 pair_lanes(__m256 texels, int j) {
                                                               2 * j + 1, 2 * j + 1));
 }
 
-// corners_of for the three axes at once (SSE lanes x, y, z; the same clamps, floors and
-// weights, so the same numbers): lanes of i0 and i1, the weights of the lower and the
-// upper voxel, and the cells of the x pairs, lower[j] and upper[j] for the (y, z) corner j
-// (bit 0 along y, bit 1 along z). Cells are computed in 32 bits, which holds levels of at
-// most 512³ voxels of six faces (sample_avx2_inline checks).
+// Lane-wise integer and rounding operations under one name for four and eight lanes, so
+// the one-cone sampler (the three axes in four lanes) and the fan (eight cones per axis)
+// share the corner arithmetic below. Float arithmetic uses the vector types' operators.
+GILAB_AVX2_INLINE __m128 lanes_floor(__m128 v) { return _mm_floor_ps(v); }
+GILAB_AVX2_INLINE __m256 lanes_floor(__m256 v) { return _mm256_floor_ps(v); }
+GILAB_AVX2_INLINE __m128 lanes_min(__m128 a, __m128 b) { return _mm_min_ps(a, b); }
+GILAB_AVX2_INLINE __m256 lanes_min(__m256 a, __m256 b) { return _mm256_min_ps(a, b); }
+GILAB_AVX2_INLINE __m128 lanes_max(__m128 a, __m128 b) { return _mm_max_ps(a, b); }
+GILAB_AVX2_INLINE __m256 lanes_max(__m256 a, __m256 b) { return _mm256_max_ps(a, b); }
+GILAB_AVX2_INLINE __m128 lanes_float(__m128i v) { return _mm_cvtepi32_ps(v); }
+GILAB_AVX2_INLINE __m256 lanes_float(__m256i v) { return _mm256_cvtepi32_ps(v); }
+GILAB_AVX2_INLINE __m128i lanes_truncate(__m128 v) { return _mm_cvttps_epi32(v); }
+GILAB_AVX2_INLINE __m256i lanes_truncate(__m256 v) { return _mm256_cvttps_epi32(v); }
+GILAB_AVX2_INLINE __m128i lanes_add(__m128i a, __m128i b) { return _mm_add_epi32(a, b); }
+GILAB_AVX2_INLINE __m256i lanes_add(__m256i a, __m256i b) { return _mm256_add_epi32(a, b); }
+GILAB_AVX2_INLINE __m128i lanes_and(__m128i a, __m128i b) { return _mm_and_si128(a, b); }
+GILAB_AVX2_INLINE __m256i lanes_and(__m256i a, __m256i b) { return _mm256_and_si256(a, b); }
+GILAB_AVX2_INLINE __m128i lanes_mul(__m128i a, __m128i b) { return _mm_mullo_epi32(a, b); }
+GILAB_AVX2_INLINE __m256i lanes_mul(__m256i a, __m256i b) { return _mm256_mullo_epi32(a, b); }
+GILAB_AVX2_INLINE __m128i lanes_min(__m128i a, __m128i b) { return _mm_min_epi32(a, b); }
+GILAB_AVX2_INLINE __m256i lanes_min(__m256i a, __m256i b) { return _mm256_min_epi32(a, b); }
+// The vector types of four and eight lanes (named here, not as template arguments, which
+// would drop their attributes).
+template <int kLanes>
+struct LaneTypes;
+template <>
+struct LaneTypes<4> {
+    using F = __m128;
+    using I = __m128i;
+    static I of(int v) { return _mm_set1_epi32(v); }
+};
+template <>
+struct LaneTypes<8> {
+    using F = __m256;
+    using I = __m256i;
+    static I of(int v) { return _mm256_set1_epi32(v); }
+};
+
+// corners_of along one axis, lane by lane (the same clamps, floors and weights, so the
+// same numbers): the lower and upper voxel, their weights and their cells (stride ×
+// the voxel wrapped into the level's store). Cells are computed in 32 bits, which holds
+// levels of at most 512³ voxels of six faces (sample_avx2_inline checks).
+template <int kLanes>
+struct AxisCorners {
+    using F = typename LaneTypes<kLanes>::F;
+    using I = typename LaneTypes<kLanes>::I;
+    I i0, i1, cell0, cell1;
+    F w0, w1;
+};
+template <int kLanes, class F = typename LaneTypes<kLanes>::F, class I = typename LaneTypes<kLanes>::I>
+GILAB_AVX2_INLINE AxisCorners<kLanes> axis_corners(F p, F anchor, F inv_voxel, I lo, I hi, I wrap, I stride) {
+    const F q = lanes_min(lanes_max((p - anchor) * inv_voxel - 0.5f, lanes_float(lo)), lanes_float(hi));
+    const F f = lanes_floor(q);
+    AxisCorners<kLanes> c;
+    c.i0 = lanes_truncate(f);
+    c.i1 = lanes_min(lanes_add(c.i0, LaneTypes<kLanes>::of(1)), hi);
+    c.w1 = q - f;
+    c.w0 = 1.0f - c.w1;
+    c.cell0 = lanes_mul(lanes_and(c.i0, wrap), stride);
+    c.cell1 = lanes_mul(lanes_and(c.i1, wrap), stride);
+    return c;
+}
+
+// clip_mask's rule on eight texel weights, given each texel's signed distance d to the
+// plane and the level's clip_half_width: a face turned to the plane's front keeps the
+// texels whose box reaches in front of it, the other faces only the texels wholly in front.
+struct ClipWeights {
+    __m256 front, back;
+};
+GILAB_AVX2_INLINE ClipWeights clip_weights(__m256 weight, __m256 d, __m256 half) {
+    const __m256 zero = _mm256_setzero_ps();
+    return {_mm256_and_ps(weight, _mm256_cmp_ps(_mm256_add_ps(d, half), zero, _CMP_GT_OQ)),
+            _mm256_and_ps(weight, _mm256_cmp_ps(_mm256_sub_ps(d, half), zero, _CMP_GT_OQ))};
+}
+
+// A sample's sum: for each (y, z) corner j (bit 0 along y, bit 1 along z) and face f, the
+// x pair at cells `lower(j)` and `upper(j)` weighted by `pair_weight(f, j)` (the lower
+// texel's weight over lanes 0–3, the upper's over 4–7), then the three faces by how much
+// the cone sees them. The one-cone sampler and the fan both sum here, in this order.
+template <class Lower, class Upper, class PairWeight>
+GILAB_AVX2_INLINE Vec4 sum_pairs(const ConeLevel& l, const FaceWeights& faces, Lower lower, Upper upper,
+                                 PairWeight pair_weight) {
+    const HalfRGBA* face[3];
+    for (int f = 0; f < 3; ++f) face[f] = l.data + size_t(faces.face[size_t(f)]) * l.face_stride;
+    const __m256 zero = _mm256_setzero_ps();
+    __m256 acc[3] = {zero, zero, zero};
+    for (int j = 0; j < 4; ++j)
+        for (int f = 0; f < 3; ++f)
+            acc[f] = _mm256_fmadd_ps(load_pair(face[f] + lower(j), face[f] + upper(j)), pair_weight(f, j), acc[f]);
+    __m256 sum = _mm256_mul_ps(acc[0], _mm256_set1_ps(faces.weight[0]));
+    sum = _mm256_fmadd_ps(acc[1], _mm256_set1_ps(faces.weight[1]), sum);
+    sum = _mm256_fmadd_ps(acc[2], _mm256_set1_ps(faces.weight[2]), sum);
+    alignas(16) float out[4];
+    _mm_store_ps(out, _mm_add_ps(_mm256_castps256_ps128(sum), _mm256_extractf128_ps(sum, 1)));
+    return {out[0], out[1], out[2], out[3]};
+}
+
+// axis_corners for the three axes at once (SSE lanes x, y, z) and the cells of the x
+// pairs, lower[j] and upper[j] for the (y, z) corner j.
 struct PairCorners {
     __m128i i0, i1;
     __m128 w0, w1;
@@ -296,21 +390,14 @@ struct PairCorners {
     int occupancy;
 };
 GILAB_AVX2_INLINE PairCorners pair_corners_of(const ConeLevel& l, const Vec3& anchor, const Vec3& p) {
-    const __m128 pos = _mm_setr_ps(p.x, p.y, p.z, 0.0f), anc = _mm_setr_ps(anchor.x, anchor.y, anchor.z, 0.0f);
-    const __m128i lo_i = _mm_setr_epi32(l.origin.x, l.origin.y, l.origin.z, 0);
-    const __m128i hi_i = _mm_add_epi32(lo_i, _mm_set1_epi32(l.size - 1));
-    __m128 q = _mm_sub_ps(_mm_mul_ps(_mm_sub_ps(pos, anc), _mm_set1_ps(l.inv_voxel_size)), _mm_set1_ps(0.5f));
-    q = _mm_min_ps(_mm_max_ps(q, _mm_cvtepi32_ps(lo_i)), _mm_cvtepi32_ps(hi_i));
-    const __m128 f = _mm_floor_ps(q);
+    const __m128i lo = _mm_setr_epi32(l.origin.x, l.origin.y, l.origin.z, 0);
+    const AxisCorners<4> a = axis_corners<4>(
+        _mm_setr_ps(p.x, p.y, p.z, 0.0f), _mm_setr_ps(anchor.x, anchor.y, anchor.z, 0.0f),
+        _mm_set1_ps(l.inv_voxel_size), lo, _mm_add_epi32(lo, _mm_set1_epi32(l.size - 1)), _mm_set1_epi32(l.wrap_mask),
+        _mm_setr_epi32(int(l.x_stride), int(l.row_stride), int(l.slice_stride), 0));
     PairCorners c;
-    c.i0 = _mm_cvttps_epi32(f);
-    c.i1 = _mm_min_epi32(_mm_add_epi32(c.i0, _mm_set1_epi32(1)), hi_i);
-    c.w1 = _mm_sub_ps(q, f);
-    c.w0 = _mm_sub_ps(_mm_set1_ps(1.0f), c.w1);
-    const __m128i wrap = _mm_set1_epi32(l.wrap_mask);
-    const __m128i t0 = _mm_and_si128(c.i0, wrap), t1 = _mm_and_si128(c.i1, wrap);
-    const __m128i stride = _mm_setr_epi32(int(l.x_stride), int(l.row_stride), int(l.slice_stride), 0);
-    const __m128i o0 = _mm_mullo_epi32(t0, stride), o1 = _mm_mullo_epi32(t1, stride);
+    c.i0 = a.i0, c.i1 = a.i1, c.w0 = a.w0, c.w1 = a.w1;
+    const __m128i o0 = a.cell0, o1 = a.cell1;
     // Rows: the z and y cells of corner j, then the x cells added.
     const __m128i xy = _mm_unpacklo_epi32(o0, o1);                                         // x0 x1 y0 y1
     const __m128i oy = _mm_shuffle_epi32(xy, _MM_SHUFFLE(3, 2, 3, 2));                     // y0 y1 y0 y1
@@ -318,7 +405,8 @@ GILAB_AVX2_INLINE PairCorners pair_corners_of(const ConeLevel& l, const Vec3& an
     const __m128i row = _mm_add_epi32(oz, oy);
     _mm_storeu_si128(reinterpret_cast<__m128i*>(c.lower), _mm_add_epi32(row, _mm_shuffle_epi32(o0, 0)));
     _mm_storeu_si128(reinterpret_cast<__m128i*>(c.upper), _mm_add_epi32(row, _mm_shuffle_epi32(o1, 0)));
-    const __m128i occ = _mm_mullo_epi32(t0, _mm_setr_epi32(1, int(l.occupancy_row), int(l.occupancy_slice), 0));
+    const __m128i occ = _mm_mullo_epi32(_mm_and_si128(a.i0, _mm_set1_epi32(l.wrap_mask)),
+                                        _mm_setr_epi32(1, int(l.occupancy_row), int(l.occupancy_slice), 0));
     c.occupancy =
         _mm_cvtsi128_si32(_mm_add_epi32(_mm_add_epi32(occ, _mm_shuffle_epi32(occ, 1)), _mm_shuffle_epi32(occ, 2)));
     return c;
@@ -329,45 +417,23 @@ GILAB_AVX2_INLINE Vec4 sample_avx2_inline(const ConeLevel& l, const Vec3& anchor
     if (l.size > 512) return sample_portable(l, anchor, p, faces, plane);
     const PairCorners c = pair_corners_of(l, anchor, p);
     if (l.occupancy && !occupancy_bit(l.occupancy, size_t(c.occupancy))) return Vec4(0.0f);  // all eight texels empty
-    const HalfRGBA* face[3];
-    for (int f = 0; f < 3; ++f) face[f] = l.data + size_t(faces.face[size_t(f)]) * l.face_stride;
     const Texels8 w = spread(c.w0, c.w1);
     const __m256 weight = _mm256_mul_ps(_mm256_mul_ps(w.z, w.y), w.x);
-    const __m256 zero = _mm256_setzero_ps();
-    __m256 acc[3] = {zero, zero, zero};
-    if (plane) {
-        // clip_geometry: n[a] × (anchor[a] + (i + 0.5) × voxel) for i0 and i1, then
-        // clip_mask's rule: a face turned to the plane's front keeps texels whose box
-        // reaches in front of it, the other faces only texels wholly in front.
-        const __m128 n = _mm_setr_ps(plane->x, plane->y, plane->z, 0.0f);
-        const __m128 anc = _mm_setr_ps(anchor.x, anchor.y, anchor.z, 0.0f), vs = _mm_set1_ps(l.voxel_size);
-        const __m128 h = _mm_set1_ps(0.5f);
-        const __m128 s0 = clip_centre_term(n, anc, _mm_cvtepi32_ps(c.i0), vs, h);
-        const __m128 s1 = clip_centre_term(n, anc, _mm_cvtepi32_ps(c.i1), vs, h);
-        const Texels8 s = spread(s0, s1);
-        const __m256 d = _mm256_sub_ps(_mm256_add_ps(_mm256_add_ps(s.x, s.y), s.z), _mm256_set1_ps(plane->w));
-        const __m256 half = _mm256_set1_ps(clip_half_width(l, *plane));
-        const __m256 front = _mm256_and_ps(weight, _mm256_cmp_ps(_mm256_add_ps(d, half), zero, _CMP_GT_OQ));
-        const __m256 back = _mm256_and_ps(weight, _mm256_cmp_ps(_mm256_sub_ps(d, half), zero, _CMP_GT_OQ));
-        __m256 face_weight[3];
-        for (int f = 0; f < 3; ++f) face_weight[f] = faces_plane_front(faces.face[size_t(f)], *plane) ? front : back;
-        for (int j = 0; j < 4; ++j)  // the (y, z) corner: bit 0 along y, bit 1 along z
-            for (int f = 0; f < 3; ++f)
-                acc[f] = _mm256_fmadd_ps(load_pair(face[f] + c.lower[j], face[f] + c.upper[j]),
-                                         pair_lanes(face_weight[f], j), acc[f]);
-    } else {
-        for (int j = 0; j < 4; ++j) {
-            const __m256 pair_weight = pair_lanes(weight, j);
-            for (int f = 0; f < 3; ++f)
-                acc[f] = _mm256_fmadd_ps(load_pair(face[f] + c.lower[j], face[f] + c.upper[j]), pair_weight, acc[f]);
-        }
-    }
-    __m256 sum = _mm256_mul_ps(acc[0], _mm256_set1_ps(faces.weight[0]));
-    sum = _mm256_fmadd_ps(acc[1], _mm256_set1_ps(faces.weight[1]), sum);
-    sum = _mm256_fmadd_ps(acc[2], _mm256_set1_ps(faces.weight[2]), sum);
-    alignas(16) float out[4];
-    _mm_store_ps(out, _mm_add_ps(_mm256_castps256_ps128(sum), _mm256_extractf128_ps(sum, 1)));
-    return {out[0], out[1], out[2], out[3]};
+    auto lower = [&](int j) { return c.lower[j]; };
+    auto upper = [&](int j) { return c.upper[j]; };
+    if (!plane) return sum_pairs(l, faces, lower, upper, [&](int, int j) { return pair_lanes(weight, j); });
+    // clip_geometry: n[a] × (anchor[a] + (i + 0.5) × voxel) for i0 and i1, summed over
+    // the axes for each texel.
+    const __m128 n = _mm_setr_ps(plane->x, plane->y, plane->z, 0.0f);
+    const __m128 anc = _mm_setr_ps(anchor.x, anchor.y, anchor.z, 0.0f), vs = _mm_set1_ps(l.voxel_size);
+    const __m128 h = _mm_set1_ps(0.5f);
+    const Texels8 s = spread(clip_centre_term(n, anc, _mm_cvtepi32_ps(c.i0), vs, h),
+                             clip_centre_term(n, anc, _mm_cvtepi32_ps(c.i1), vs, h));
+    const __m256 d = _mm256_sub_ps(_mm256_add_ps(_mm256_add_ps(s.x, s.y), s.z), _mm256_set1_ps(plane->w));
+    const ClipWeights clip = clip_weights(weight, d, _mm256_set1_ps(clip_half_width(l, *plane)));
+    __m256 face_weight[3];
+    for (int f = 0; f < 3; ++f) face_weight[f] = faces_plane_front(faces.face[size_t(f)], *plane) ? clip.front : clip.back;
+    return sum_pairs(l, faces, lower, upper, [&](int f, int j) { return pair_lanes(face_weight[f], j); });
 }
 #undef GILAB_AVX2_INLINE
 
