@@ -130,8 +130,19 @@ struct ClipGeometry {
     float s[3][2];  // n[a] × the voxel centre's coordinate a, for the lower and upper voxel
     float half;
 };
+// Split in two so that eight lanes, each with its own plane, multiply the same numbers.
+[[gnu::always_inline]] inline float clip_half_unit(const ConeLevel& l) { return 0.501f * l.voxel_size; }
+[[gnu::always_inline]] inline float plane_norm1(const Vec4& plane) {
+    return std::abs(plane.x) + std::abs(plane.y) + std::abs(plane.z);
+}
 [[gnu::always_inline]] inline float clip_half_width(const ConeLevel& l, const Vec4& plane) {
-    return 0.501f * l.voxel_size * (std::abs(plane.x) + std::abs(plane.y) + std::abs(plane.z));
+    return clip_half_unit(l) * plane_norm1(plane);
+}
+// In voxels of the sampled level: a sample farther in front of the clip plane than its
+// eight voxel centres reach (one voxel per axis) plus clip_mask's half-voxel test is never
+// clipped; blending also reads the next level, of twice the voxel.
+[[gnu::always_inline]] inline float clip_reach(const Vec4& plane, bool blend_levels) {
+    return 1.502f * (blend_levels ? 2.0f : 1.0f) * plane_norm1(plane);
 }
 // n[a] × the coordinate a of voxel i's centre: one float, or four or eight lanes (GCC and Clang
 // vector types take the same operators), so both kernels compute it alike.
@@ -458,10 +469,21 @@ namespace avx2_kernel {
 
 void trace_fan_avx2(const VoxelConeView& view, const Vec3& apex, std::span<const Vec3> directions,
                     float tan_half_angle, const ConeOptions& options, std::span<ConeResult> results) {
-    for (size_t b = 0; b < directions.size(); b += 8)
-        avx2_kernel::march_fan8<sample_avx2_inline>(view, apex, directions.data() + b,
-                                                    int(std::min<size_t>(8, directions.size() - b)), tan_half_angle,
-                                                    options, results.data() + b);
+    avx2_kernel::FanStart start;
+    for (size_t b = 0; b < directions.size(); b += 8) {
+        const int count = int(std::min<size_t>(8, directions.size() - b));
+        avx2_kernel::fan_start_shared(start, apex, directions.data() + b, count, tan_half_angle, options);
+        avx2_kernel::march_fan8<sample_avx2_inline>(view, start, options, results.data() + b);
+    }
+}
+
+void trace_cones_avx2(const VoxelConeView& view, std::span<const ConeLaunch> launches, const ConeOptions& options,
+                      std::span<ConeResult> results) {
+    avx2_kernel::FanStart start;
+    for (size_t b = 0; b < launches.size(); b += 8) {
+        avx2_kernel::fan_start_each(start, launches.data() + b, int(std::min<size_t>(8, launches.size() - b)), options);
+        avx2_kernel::march_fan8<sample_avx2_inline>(view, start, options, results.data() + b);
+    }
 }
 
 #if defined(__clang__)
@@ -541,6 +563,24 @@ void trace_cone_fan(const VoxelConeView& view, const Vec3& apex, std::span<const
 void trace_cone_fan(const VoxelConeView& view, const Vec3& apex, std::span<const Vec3> directions,
                     float tan_half_angle, const ConeOptions& options, std::span<ConeResult> results) {
     trace_cone_fan(view, apex, directions, tan_half_angle, options, results, best_cone_kernel());
+}
+
+void trace_cones(const VoxelConeView& view, std::span<const ConeLaunch> launches, const ConeOptions& options,
+                 std::span<ConeResult> results, ConeKernel kernel) {
+    require_supported(kernel);
+    if (results.size() != launches.size())
+        throw Error("cone tracer", "a batch of " + std::to_string(launches.size()) +
+                                       " cones needs as many results, got " + std::to_string(results.size()));
+#if GILAB_CONE_AVX2
+    if (kernel == ConeKernel::avx2) return trace_cones_avx2(view, launches, options, results);
+#endif
+    for (size_t i = 0; i < launches.size(); ++i)
+        results[i] = trace_cone_portable(view, launches[i].cone, launches[i].options_from(options));
+}
+
+void trace_cones(const VoxelConeView& view, std::span<const ConeLaunch> launches, const ConeOptions& options,
+                 std::span<ConeResult> results) {
+    trace_cones(view, launches, options, results, best_cone_kernel());
 }
 
 ConeSet hemisphere_cones(int count) {

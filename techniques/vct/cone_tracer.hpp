@@ -156,6 +156,28 @@ void trace_cone_fan(const VoxelConeView& view, const Vec3& apex, std::span<const
                     float tan_half_angle, const ConeOptions& options, std::span<ConeResult> results,
                     ConeKernel kernel);
 
+// One cone of a batch whose cones share their options but for where each starts and the
+// plane that clips it (neighbouring pixels' specular cones: each its own apex, aperture,
+// first sample and surface).
+struct ConeLaunch {
+    Cone cone;
+    float start = 1.0f;       // replaces ConeOptions::start
+    Vec4 clip_plane{0};       // replaces ConeOptions::clip_plane (used where options.clip)
+    ConeOptions options_from(const ConeOptions& shared) const {
+        ConeOptions o = shared;
+        o.start = start;
+        o.clip_plane = clip_plane;
+        return o;
+    }
+};
+
+// results[i] is trace_cone(view, launches[i].cone, launches[i].options_from(options)), bit
+// for bit; the AVX2 kernel marches eight launches at a time as a fan does.
+void trace_cones(const VoxelConeView& view, std::span<const ConeLaunch> launches, const ConeOptions& options,
+                 std::span<ConeResult> results);
+void trace_cones(const VoxelConeView& view, std::span<const ConeLaunch> launches, const ConeOptions& options,
+                 std::span<ConeResult> results, ConeKernel kernel);
+
 // Fixed cones over the hemisphere around +z (P3: 16 cones): equal solid angle 2π/N each
 // (axes on a spiral, uniform in cos θ), half aperture with that solid angle. The weights
 // W_k are the solid angles (ΣW = 2π); the irradiance estimate is Σ L_k cos θ_k W_k and

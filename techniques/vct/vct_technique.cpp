@@ -800,8 +800,13 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
 
         watch.reset();
         if (settings_.specular) {
+            // A tile's glossy pixels, in scanline order, go out together: neighbours' mirror
+            // cones are alike in length, so a batch's lanes stay busy.
             parallel_for_tiles(width, height, ts, [&](const Tile& tile) {
                 uint64_t local = 0, samples = 0;
+                std::vector<ConeLaunch> launches;
+                std::vector<size_t> pixel;
+                std::vector<float> cosine;
                 for (int y = tile.y0; y < tile.y1; ++y)
                     for (int x = tile.x0; x < tile.x1; ++x) {
                         const size_t i = size_t(y) * size_t(width) + size_t(x);
@@ -813,11 +818,20 @@ void VctTechnique::render(const ViewSet& views, std::vector<Film>& films) {
                         const float cos_r = glm::dot(r, ph.normal);
                         if (cos_r <= 0.0f) continue;
                         const SurfaceCones sc = cones_at(ph);
-                        ConeResult c = trace_cone(view, Cone{sc.apex, r, phong_cone_tan(m.phong_exponent)}, sc.options);
-                        put(specular, i, m.specular * c.radiance * cos_r);
-                        ++local;
-                        samples += uint64_t(c.samples);
+                        launches.push_back({Cone{sc.apex, r, phong_cone_tan(m.phong_exponent)}, sc.options.start,
+                                            sc.options.clip_plane});
+                        pixel.push_back(i);
+                        cosine.push_back(cos_r);
                     }
+                std::vector<ConeResult> results(launches.size());
+                ConeOptions shared = options;
+                shared.clip = settings_.clip_plane;
+                trace_cones(view, launches, shared, results);
+                for (size_t j = 0; j < launches.size(); ++j) {
+                    put(specular, pixel[j], hits[pixel[j]].surface.specular * results[j].radiance * cosine[j]);
+                    ++local;
+                    samples += uint64_t(results[j].samples);
+                }
                 cones += local;
                 specular_cones += local;
                 specular_samples += samples;

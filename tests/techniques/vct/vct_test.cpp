@@ -311,6 +311,68 @@ TEST(ConeTracer, FansGiveEachConeItsOwnResult) {
                  Error);
 }
 
+// A batch of unrelated cones (each its own apex, direction, aperture, start and clip plane,
+// as neighbouring pixels' specular cones are) gives each cone exactly trace_cone's result
+// with the launch's start and plane, under both kernels, on cascades and a dense chain,
+// for batches of 1 to 20 cones, with the clip plane, blending and the box on and off.
+TEST(ConeTracer, BatchesGiveEachConeItsOwnResult) {
+    Scene scene = make_cornell_box();
+    std::vector<ConeKernel> kernels{ConeKernel::portable};
+    if (best_cone_kernel() == ConeKernel::avx2) kernels.push_back(ConeKernel::avx2);
+    for (const char* structure : {"cascaded", "dense"}) {
+        auto vct = prepared(scene, {{"structure", structure}, {"dense_resolution", 64}});
+        render_one(*vct, inside_camera(16));
+        const VoxelConeView view = vct->radiance_view();
+        const ConeLevel& inner = view.level(std::min(1, view.level_count() - 1));
+        Bounds3 box;
+        box.min = view.anchor() + Vec3(inner.origin) * inner.voxel_size;
+        box.max = box.min + Vec3(float(inner.size) * inner.voxel_size);
+        Rng rng(7, 4);
+        int compared = 0, lit = 0;
+        for (int i = 0; i < 120; ++i) {
+            ConeOptions shared;
+            shared.clip = i % 2 == 0;
+            shared.blend_levels = i % 3 != 0;
+            shared.correct_opacity = i % 5 == 0;
+            if (i % 4 != 3) shared.bounds = box;
+            const int count = 1 + i % 20;
+            std::vector<ConeLaunch> launches;
+            for (int c = 0; c < count; ++c) {
+                const int k = std::min(int(rng.uniform() * float(view.level_count())), view.level_count() - 1);
+                const ConeLevel& l = view.level(k);
+                const Vec3 u(rng.uniform(), rng.uniform(), rng.uniform());
+                const Vec3 apex = view.anchor() + (Vec3(l.origin) + u * float(l.size)) * l.voxel_size;
+                const Vec3 n = glm::normalize(Vec3(rng.uniform(), rng.uniform(), rng.uniform()) - Vec3(0.5f) + Vec3(1e-3f));
+                const Vec3 d = glm::normalize(n + Vec3(rng.uniform(), rng.uniform(), rng.uniform()) - Vec3(0.5f));
+                const float tan_half = 0.02f + 0.6f * rng.uniform();
+                const float start = (0.5f + 2.0f * rng.uniform()) * view.base_voxel_size();
+                launches.push_back({Cone{apex, d, tan_half}, start, Vec4(n, glm::dot(n, apex) - 0.3f * l.voxel_size)});
+            }
+            for (ConeKernel kernel : kernels) {
+                std::vector<ConeResult> batch(launches.size());
+                trace_cones(view, launches, shared, batch, kernel);
+                for (int c = 0; c < count; ++c) {
+                    const ConeLaunch& launch = launches[size_t(c)];
+                    const ConeResult one = trace_cone(view, launch.cone, launch.options_from(shared), kernel);
+                    const ConeResult& b = batch[size_t(c)];
+                    ASSERT_EQ(b.samples, one.samples)
+                        << structure << " batch " << i << " cone " << c << " " << to_string(kernel);
+                    ASSERT_EQ(b.radiance, one.radiance) << structure << " batch " << i << " cone " << c;
+                    ASSERT_EQ(b.opacity, one.opacity) << structure << " batch " << i << " cone " << c;
+                    ASSERT_EQ(b.occlusion, one.occlusion) << structure << " batch " << i << " cone " << c;
+                    ++compared;
+                    lit += one.opacity > 0.01f;
+                }
+            }
+        }
+        EXPECT_GT(lit, compared / 10) << structure << ": too few cones saw anything for the comparison to mean much";
+    }
+    std::vector<ConeResult> short_results(1);
+    const std::vector<ConeLaunch> two(2);
+    const CascadedVoxelTexture empty = constant_levels(0.0f);
+    EXPECT_THROW(trace_cones(VoxelConeView::cascade(empty, empty.radiance), two, {}, short_results), Error);
+}
+
 // Levels above 512³ voxels take the portable sampler under the AVX2 kernel (its 32-bit
 // cells would not hold them): there the two kernels agree bit for bit, while on a level
 // of 512³ over the same texels the AVX2 sums, rounded otherwise, differ somewhere.
